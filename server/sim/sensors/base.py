@@ -1,0 +1,41 @@
+"""The contract every simulated sensor follows.
+
+A sensor is a pure function of the world, the robot state, the simulated time and its own seeded
+random generator: `sample()` builds one message. The simulation calls it when the sensor's topic
+is due (at `rate_hz`), passing a generator that belongs to this sensor alone, so reading one
+topic more or less often never changes another topic's noise.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Protocol
+
+if TYPE_CHECKING:
+    import numpy as np
+
+    from server.sim.state import RobotState
+    from server.sim.world import LightSource, World
+
+
+@dataclass(frozen=True, slots=True)
+class SenseContext:
+    """What a sensor may look at when it samples: the compiled world, the robot state, the
+    simulated time [s] since reset, and the light sources where they are now (lights can be
+    moved during a run, so they live here rather than in the immutable `World`)."""
+
+    world: World
+    state: RobotState
+    time_s: float
+    lights: tuple[LightSource, ...]
+
+
+class Sensor(Protocol):
+    """A simulated sensor: it publishes `msg_type` messages at `rate_hz` [Hz]."""
+
+    msg_type: type
+    rate_hz: float
+
+    def sample(self, ctx: SenseContext, rng: np.random.Generator) -> object:
+        """Return one message of `msg_type` for the state in `ctx`."""
+        ...
