@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Protocol
 if TYPE_CHECKING:
     import numpy as np
 
+    from server.sim.obstacles import Obstacles
     from server.sim.state import RobotState
     from server.sim.world import LightSource, World
 
@@ -22,9 +23,11 @@ if TYPE_CHECKING:
 class SenseContext:
     """What a sensor may look at when it samples: the compiled world, the robot state, the
     simulated time [s] since reset, and the light sources where they are now (lights can be
-    moved during a run, so they live here rather than in the immutable `World`)."""
+    moved during a run, so they live here rather than in the immutable `World`), and the world's
+    solid surfaces prepared for ray casts (`obstacles`)."""
 
     world: World
+    obstacles: Obstacles
     state: RobotState
     time_s: float
     lights: tuple[LightSource, ...]
