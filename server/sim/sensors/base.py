@@ -34,11 +34,26 @@ class SenseContext:
 
 
 class Sensor(Protocol):
-    """A simulated sensor: it publishes `msg_type` messages at `rate_hz` [Hz]."""
+    """A simulated sensor: it publishes `msg_type` messages at `rate_hz` [Hz], the first one at
+    `phase_s` [s] after reset (rangers fired one after another use different phases)."""
 
     msg_type: type
     rate_hz: float
+    phase_s: float
+
+    def reset(self) -> None:
+        """Forget internal state (a drifting bias, a previous reading) before a new episode."""
+        ...
 
     def sample(self, ctx: SenseContext, rng: np.random.Generator) -> object:
         """Return one message of `msg_type` for the state in `ctx`."""
         ...
+
+
+class StatelessSensor:
+    """Mixin for sensors without internal state: phase 0, nothing to reset."""
+
+    phase_s: float = 0.0
+
+    def reset(self) -> None:
+        return None
