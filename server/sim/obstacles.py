@@ -43,9 +43,10 @@ class Obstacles:
         lengths = np.hypot(self.segment_vector[:, 0], self.segment_vector[:, 1])
         self.segment_length_sq = np.maximum(lengths**2, 1e-18)
         # Unit normals; the sign does not matter because incidence uses |cos|.
-        self.segment_normal = np.stack(
-            [-self.segment_vector[:, 1], self.segment_vector[:, 0]], axis=1
-        ) / np.maximum(lengths, 1e-9)[:, None]
+        self.segment_normal = (
+            np.stack([-self.segment_vector[:, 1], self.segment_vector[:, 0]], axis=1)
+            / np.maximum(lengths, 1e-9)[:, None]
+        )
         self.segment_height = np.asarray(world.segment_height, dtype=np.float64).reshape(-1)
         self.circle_centre = circles[:, 0:2]
         self.circle_radius = circles[:, 2]
@@ -170,3 +171,20 @@ class Obstacles:
         push = np.concatenate(pushes)
         angle = np.arctan2(-push[:, 1], -push[:, 0])
         return push, angle
+
+    def clearance(self, x: float, y: float) -> float:
+        """Distance [m] from the point (x, y) to the nearest surface (inf in an empty world)."""
+        point = np.array([x, y])
+        nearest = np.inf
+        if len(self.segment_start):
+            rel = point - self.segment_start
+            along = np.clip(
+                np.sum(rel * self.segment_vector, axis=1) / self.segment_length_sq, 0.0, 1.0
+            )
+            away = rel - along[:, None] * self.segment_vector
+            nearest = float(np.min(np.hypot(away[:, 0], away[:, 1])))
+        if len(self.circle_centre):
+            away_c = point - self.circle_centre
+            gaps = np.hypot(away_c[:, 0], away_c[:, 1]) - self.circle_radius
+            nearest = min(nearest, float(np.min(gaps)))
+        return nearest

@@ -45,6 +45,7 @@ class RobotState:
     distance_travelled_m: float = 0.0
     time_out_of_bounds_s: float = 0.0
     servo_angle_deg: float = 90.0
+    servo_target_deg: float = 90.0
     button_pressed: bool = False
     leds_rgb: tuple[int, int, int] = (0, 0, 0)
     buzzer_on: bool = False

@@ -1,0 +1,52 @@
+"""Robots by id. Worlds have their own registry in server.sim.world; this module joins the two
+(which robot makes sense in which world, as the worlds declare)."""
+
+from __future__ import annotations
+
+from server.sim.robots.base import RobotModel, validate_robot
+from server.sim.robots.crop_rover import CropRover
+from server.sim.robots.crowbot import CrowBot
+from server.sim.robots.ir_scout import IrScout
+from server.sim.robots.turtlebot import TurtleBot
+from server.sim.world import load_world, world_ids
+
+_ROBOTS: dict[str, type[RobotModel]] = {
+    cls.id: cls for cls in (CrowBot, CropRover, IrScout, TurtleBot)
+}
+
+
+class UnknownRobotError(ValueError):
+    pass
+
+
+def robot_ids() -> tuple[str, ...]:
+    return tuple(sorted(_ROBOTS))
+
+
+def get_robot(robot_id: str) -> RobotModel:
+    """A fresh model of the robot `robot_id`; unknown ids fail with the list of valid ones."""
+    cls = _ROBOTS.get(robot_id)
+    if cls is None:
+        raise UnknownRobotError(
+            f"unknown robot '{robot_id}'; valid robot ids: {', '.join(robot_ids())}"
+        )
+    return cls()
+
+
+def robots_for_world(robot_id: str) -> tuple[str, ...]:
+    """Ids of the worlds that declare they suit `robot_id`."""
+    return tuple(w for w in world_ids() if robot_id in load_world(w).robots)
+
+
+def validate_registry() -> list[str]:
+    """Problems across all robots and worlds, as sentences."""
+    problems: list[str] = []
+    for robot_id in robot_ids():
+        problems.extend(validate_robot(get_robot(robot_id)))
+        if not robots_for_world(robot_id):
+            problems.append(f"robot '{robot_id}' has no world to drive in")
+    for world_id in world_ids():
+        for robot_id in load_world(world_id).robots:
+            if robot_id not in _ROBOTS:
+                problems.append(f"world '{world_id}' names unknown robot '{robot_id}'")
+    return problems

@@ -1,0 +1,169 @@
+"""What a robot is to the simulator: a registry entry that declares its topics, geometry and
+limits, builds its sensors and motor model, and turns command messages into motor commands.
+
+Each robot module defines one `RobotModel` subclass; `server.sim.robots` registers them by id and
+`validate_robot` checks every entry (the tests run it over the whole registry).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from enum import StrEnum
+from typing import ClassVar, Protocol
+
+from server.sim.sensors.base import Sensor
+from server.sim.state import RobotState
+
+
+class Direction(StrEnum):
+    """Seen from the robot: it publishes sensor topics and subscribes to command topics."""
+
+    PUBLISH = "publish"
+    SUBSCRIBE = "subscribe"
+
+
+@dataclass(frozen=True, slots=True)
+class TopicSpec:
+    """One topic of a robot: name, ROS message class, direction, rate [Hz] (publishers only)."""
+
+    name: str
+    msg_type: type
+    direction: Direction
+    rate_hz: float | None
+    description: str
+
+    @property
+    def type_name(self) -> str:
+        return self.msg_type._type
+
+
+@dataclass(frozen=True, slots=True)
+class RobotGeometry:
+    """Sizes [m]. The body is a disc of `body_radius_m` for collisions (the circumscribed circle
+    for a rectangular chassis, so the simulated robot never fits where the real one cannot);
+    `length_m`/`width_m`/`height_m` are for drawing."""
+
+    body_radius_m: float
+    wheel_radius_m: float
+    track_m: float
+    length_m: float
+    width_m: float
+    height_m: float
+
+
+@dataclass(frozen=True, slots=True)
+class RobotLimits:
+    """What the robot can physically do: top speeds the motors reach."""
+
+    max_linear_m_s: float
+    max_angular_rad_s: float
+
+
+class Motors(Protocol):
+    """A motor model (see server.sim.motors)."""
+
+    def reset(self) -> None: ...
+    def command(self, linear_m_s: float, angular_rad_s: float) -> None: ...
+    def step(self, dt_s: float) -> tuple[float, float]: ...
+
+
+class CommandError(ValueError):
+    """A command message whose content the robot cannot accept (the sentence says why)."""
+
+
+class RobotModel:
+    """Base of every robot. Subclasses set the class attributes and override the builders."""
+
+    id: ClassVar[str]
+    title: ClassVar[str]
+    source: ClassVar[str]  # the paper and section the model follows
+    geometry: ClassVar[RobotGeometry]
+    limits: ClassVar[RobotLimits]
+    # name -> (message class, description) for each command topic the robot subscribes to.
+    commands: ClassVar[dict[str, tuple[type, str]]]
+    # name -> description for each sensor topic (the sensor object supplies type and rate).
+    sensor_descriptions: ClassVar[dict[str, str]]
+
+    def build_sensors(self) -> dict[str, Sensor]:
+        """A fresh sensor object per published topic."""
+        raise NotImplementedError
+
+    def build_motors(self) -> Motors:
+        raise NotImplementedError
+
+    def apply_command(
+        self, topic: str, message: object, state: RobotState, motors: Motors, time_s: float
+    ) -> None:
+        """Act on a (type-checked, finite) command message. Raise CommandError for content the
+        robot cannot accept."""
+        raise NotImplementedError
+
+    def advance(self, state: RobotState, dt_s: float, time_s: float) -> None:
+        """Per physics tick, for actuators other than the wheels (servo slew, buzzer timer)."""
+        if state.buzzer_on and time_s >= state.buzzer_until_s:
+            state.buzzer_on = False
+
+    def topics(self) -> tuple[TopicSpec, ...]:
+        """All topics, publishers first, each with its type and rate."""
+        published = tuple(
+            TopicSpec(
+                name,
+                sensor.msg_type,
+                Direction.PUBLISH,
+                sensor.rate_hz,
+                self.sensor_descriptions.get(name, ""),
+            )
+            for name, sensor in self.build_sensors().items()
+        )
+        subscribed = tuple(
+            TopicSpec(name, msg_type, Direction.SUBSCRIBE, None, description)
+            for name, (msg_type, description) in self.commands.items()
+        )
+        return published + subscribed
+
+
+def clamp_twist(
+    linear_m_s: float, angular_rad_s: float, limits: RobotLimits
+) -> tuple[float, float]:
+    """Clip a velocity command to what the robot can do (commands beyond it are not errors:
+    students often ask for more than a robot has, as they would on the real one)."""
+    return (
+        max(-limits.max_linear_m_s, min(limits.max_linear_m_s, linear_m_s)),
+        max(-limits.max_angular_rad_s, min(limits.max_angular_rad_s, angular_rad_s)),
+    )
+
+
+def validate_robot(robot: RobotModel) -> list[str]:
+    """Problems with a registry entry, as sentences (empty when the entry is sound)."""
+    problems: list[str] = []
+    g = robot.geometry
+    for name in ("body_radius_m", "wheel_radius_m", "track_m", "length_m", "width_m", "height_m"):
+        value = getattr(g, name)
+        if not (math.isfinite(value) and value > 0):
+            problems.append(
+                f"robot '{robot.id}': geometry.{name} must be a positive size, got {value}"
+            )
+    sensors = robot.build_sensors()
+    if not sensors:
+        problems.append(f"robot '{robot.id}': publishes no sensor topics")
+    for name, sensor in sensors.items():
+        if not (sensor.rate_hz > 0 and math.isfinite(sensor.rate_hz)):
+            problems.append(f"robot '{robot.id}': topic '{name}' has rate {sensor.rate_hz} Hz")
+        if not getattr(sensor.msg_type, "_type", None):
+            problems.append(f"robot '{robot.id}': topic '{name}' type is not a ROS message class")
+        if not robot.sensor_descriptions.get(name):
+            problems.append(f"robot '{robot.id}': topic '{name}' has no description")
+    overlap = set(sensors) & set(robot.commands)
+    if overlap:
+        problems.append(
+            f"robot '{robot.id}': topics both published and subscribed: {sorted(overlap)}"
+        )
+    if not robot.commands:
+        problems.append(f"robot '{robot.id}': subscribes to no command topics")
+    for name, (msg_type, description) in robot.commands.items():
+        if not getattr(msg_type, "_type", None) or not description:
+            problems.append(
+                f"robot '{robot.id}': command '{name}' needs a message class and a description"
+            )
+    return problems

@@ -1,0 +1,385 @@
+"""The simulation a run engine drives: one robot in one world, advanced in fixed physics ticks.
+
+Contract (checked, with sentences that say what to do):
+    sim = Simulation("crowbot", "wall_approach", seed=0)
+    sim.apply("Control", Twist(...))       # a command topic the robot subscribes to
+    published = sim.step(0.05)             # sensor messages that fell due, in time order
+    sim.read("Distance")                   # latest message on a topic (None before the first)
+    sim.scene()                            # what to draw
+
+Pure: no I/O, no wall clock. Time is kept in integer nanoseconds of simulated time, so tick and
+sensor schedules never drift with float rounding; each sensor topic publishes at `phase +
+k / rate` on the first tick at or after that instant. Randomness comes from one seed, split into
+an independent stream per topic (numpy SeedSequence keyed by the topic name), so reading one
+topic more or less often never changes another's noise: same seed, same commands -> identical
+message streams, bit for bit.
+"""
+
+from __future__ import annotations
+
+import math
+import zlib
+from dataclasses import dataclass
+from enum import StrEnum
+
+import numpy as np
+
+from server.sim.kinematics import body_velocities, integrate_arc, wrap_angle
+from server.sim.obstacles import Obstacles
+from server.sim.registry import get_robot, robots_for_world
+from server.sim.robots.base import Direction, TopicSpec
+from server.sim.sensors.base import SenseContext, Sensor
+from server.sim.state import Pose2D, RobotState
+from server.sim.world import LightSource, World, load_world
+
+NS_PER_S = 1_000_000_000
+DEFAULT_PHYSICS_HZ = 1000.0  # [Hz] fine enough that a 0.13 m/s robot moves 0.13 mm per tick
+# Odometry miscalibration: each wheel's effective radius differs from the nominal one by a
+# seeded draw of this relative standard deviation, so dead reckoning drifts like a real base.
+ODOMETRY_RADIUS_ERROR = 0.01  # [1]
+_COLLISION_ITERATIONS = 4  # push-out passes per tick; a corner needs one per wall
+
+
+class SimulationError(ValueError):
+    """A call the simulation cannot accept; the message says what to do instead."""
+
+
+@dataclass(frozen=True, slots=True)
+class Published:
+    """A message a sensor topic published at simulated time `time_s` [s]."""
+
+    topic: str
+    time_s: float
+    message: object
+
+
+class EventKind(StrEnum):
+    CONTACT_BEGAN = "contact_began"
+    CONTACT_ENDED = "contact_ended"
+    LEFT_BOUNDS = "left_bounds"
+    ENTERED_BOUNDS = "entered_bounds"
+
+
+@dataclass(frozen=True, slots=True)
+class SimEvent:
+    """Something a run may want to count or show, at `time_s` [s], the robot at x, y [m]."""
+
+    kind: EventKind
+    time_s: float
+    x: float
+    y: float
+
+
+@dataclass(frozen=True, slots=True)
+class Scene:
+    """A snapshot for drawing: the true pose, actuator states, light positions, and the latest
+    message on every topic (the 3D view draws rays from those)."""
+
+    time_s: float
+    robot_id: str
+    world_id: str
+    pose: Pose2D
+    leds_rgb: tuple[int, int, int]
+    buzzer_on: bool
+    servo_angle_deg: float
+    in_contact: bool
+    lights: tuple[LightSource, ...]
+    latest: dict[str, object]
+
+
+def _topic_rng(seed: int, topic: str) -> np.random.Generator:
+    return np.random.default_rng(
+        np.random.SeedSequence(seed, spawn_key=(zlib.crc32(topic.encode()),))
+    )
+
+
+def _check_finite(message: object, path: str) -> None:
+    """Reject NaN/inf anywhere in a command: integrating one would poison the pose forever."""
+    for name in getattr(message, "__slots__", ()):
+        value = getattr(message, name)
+        if isinstance(value, float):
+            if not math.isfinite(value):
+                raise SimulationError(f"{path}.{name} is {value}; commands must be finite numbers")
+        elif isinstance(value, (list, tuple)):
+            for index, item in enumerate(value):
+                if isinstance(item, float) and not math.isfinite(item):
+                    raise SimulationError(
+                        f"{path}.{name}[{index}] is {item}; commands must be finite numbers"
+                    )
+        elif hasattr(value, "__slots__"):
+            _check_finite(value, f"{path}.{name}")
+
+
+class Simulation:
+    """One robot in one world. See the module docstring for the contract."""
+
+    def __init__(
+        self,
+        robot: str,
+        world: str | World,
+        *,
+        seed: int = 0,
+        spawn: str | Pose2D | None = None,
+        physics_hz: float = DEFAULT_PHYSICS_HZ,
+    ) -> None:
+        self.robot = get_robot(robot)
+        self.world = world if isinstance(world, World) else load_world(world)
+        if self.robot.id not in self.world.robots:
+            raise SimulationError(
+                f"robot '{self.robot.id}' is not meant for world '{self.world.id}'; worlds for "
+                f"it: {', '.join(robots_for_world(self.robot.id))}"
+            )
+        if not (math.isfinite(physics_hz) and 10.0 <= physics_hz <= 100_000.0):
+            raise SimulationError(f"physics_hz must be between 10 and 100000, got {physics_hz}")
+        self._tick_ns = round(NS_PER_S / physics_hz)
+        self._tick_s = self._tick_ns / NS_PER_S
+        self.obstacles = Obstacles(self.world)
+        self._topics = {spec.name: spec for spec in self.robot.topics()}
+        self._spawn = spawn
+        self.reset(seed)
+
+    # ----------------------------------------------------------------------------- lifecycle
+    def reset(self, seed: int | None = None) -> list[Published]:
+        """Start over at the spawn pose with fresh noise from `seed` (the last seed if None).
+
+        Returns the messages that publish at time 0."""
+        if seed is not None:
+            if not isinstance(seed, int) or seed < 0:
+                raise SimulationError(f"seed must be a non-negative integer, got {seed!r}")
+            self.seed = seed
+        spawn = self._spawn_pose(self._spawn)
+        self.state = RobotState(pose=spawn, odometry_pose=Pose2D(0.0, 0.0, 0.0))
+        self._odom_origin = spawn
+        self.lights = self.world.lights
+        self.motors = self.robot.build_motors()
+        self.motors.reset()
+        self.sensors: dict[str, Sensor] = self.robot.build_sensors()
+        self._rngs = {name: _topic_rng(self.seed, name) for name in self.sensors}
+        physics_rng = _topic_rng(self.seed, "__physics__")
+        radius = self.robot.geometry.wheel_radius_m
+        self._odom_left_radius, self._odom_right_radius = radius * (
+            1.0 + physics_rng.normal(0.0, ODOMETRY_RADIUS_ERROR, 2)
+        )
+        self._period_ns = {n: round(NS_PER_S / s.rate_hz) for n, s in self.sensors.items()}
+        self._next_due_ns = {n: round(s.phase_s * NS_PER_S) for n, s in self.sensors.items()}
+        for sensor in self.sensors.values():
+            sensor.reset()
+        self._now_ns = 0
+        self._target_ns = 0
+        self._latest: dict[str, object] = {}
+        self._events: list[SimEvent] = []
+        self._clearance_m = 0.0
+        self._out_of_bounds = not self._inside_bounds(spawn.x, spawn.y)
+        return self._publish_due()
+
+    def _spawn_pose(self, spawn: str | Pose2D | None) -> Pose2D:
+        if isinstance(spawn, Pose2D):
+            return Pose2D(spawn.x, spawn.y, spawn.yaw)
+        spawns = {s.name: s for s in self.world.spawns}
+        name = spawn or self.world.spawns[0].name
+        if name not in spawns:
+            raise SimulationError(
+                f"world '{self.world.id}' has no spawn '{name}'; choose one of {sorted(spawns)}"
+            )
+        chosen = spawns[name]
+        return Pose2D(chosen.x, chosen.y, chosen.yaw)
+
+    # ----------------------------------------------------------------------------- topics
+    @property
+    def time_s(self) -> float:
+        return self._now_ns / NS_PER_S
+
+    @property
+    def topics(self) -> tuple[TopicSpec, ...]:
+        return tuple(self._topics.values())
+
+    def _topic(self, topic: str) -> TopicSpec:
+        spec = self._topics.get(topic)
+        if spec is None:
+            raise SimulationError(
+                f"robot '{self.robot.id}' has no topic '{topic}'; its topics are "
+                + ", ".join(f"{t.name} ({t.type_name}, {t.direction})" for t in self.topics)
+            )
+        return spec
+
+    def apply(self, topic: str, message: object) -> None:
+        """Deliver a command message; it acts from the next physics tick on."""
+        spec = self._topic(topic)
+        if spec.direction is not Direction.SUBSCRIBE:
+            raise SimulationError(
+                f"'{topic}' is a sensor topic the robot publishes; commands go to "
+                + ", ".join(t.name for t in self.topics if t.direction is Direction.SUBSCRIBE)
+            )
+        if not isinstance(message, spec.msg_type):
+            got = getattr(message, "_type", type(message).__name__)
+            raise SimulationError(f"topic '{topic}' expects {spec.type_name}, got {got}")
+        _check_finite(message, topic)
+        self.robot.apply_command(topic, message, self.state, self.motors, self.time_s)
+        self._latest[topic] = message
+
+    def read(self, topic: str) -> object | None:
+        """The latest message on `topic` (a sensor reading or the last command); None before
+        the topic first published or was commanded."""
+        self._topic(topic)
+        return self._latest.get(topic)
+
+    # ----------------------------------------------------------------------------- actions
+    def press_button(self, pressed: bool) -> None:
+        self.state.button_pressed = bool(pressed)
+
+    def move_light(self, name: str, x: float, y: float) -> None:
+        """Move a movable light source to (x, y) [m]."""
+        names = [light.name for light in self.lights]
+        if name not in names:
+            raise SimulationError(f"world '{self.world.id}' has no light '{name}'; lights: {names}")
+        if not (math.isfinite(x) and math.isfinite(y)):
+            raise SimulationError(f"light position must be finite, got ({x}, {y})")
+        min_x, min_y, max_x, max_y = self.world.bounds
+        if not (min_x <= x <= max_x and min_y <= y <= max_y):
+            raise SimulationError(
+                f"({x:.2f}, {y:.2f}) is outside the world ({min_x}..{max_x}, {min_y}..{max_y} m)"
+            )
+        lights = list(self.lights)
+        index = names.index(name)
+        if not lights[index].movable:
+            raise SimulationError(f"light '{name}' is fixed in world '{self.world.id}'")
+        old = lights[index]
+        lights[index] = LightSource(old.name, float(x), float(y), old.z, old.intensity, True)
+        self.lights = tuple(lights)
+
+    def drain_events(self) -> list[SimEvent]:
+        """Contact and bounds events since the last call."""
+        events, self._events = self._events, []
+        return events
+
+    # ----------------------------------------------------------------------------- time
+    def step(self, dt_s: float) -> list[Published]:
+        """Advance simulated time by `dt_s` [s] in whole physics ticks; return what published.
+
+        Time not filling a whole tick carries over to the next call, so many small steps add
+        up to exactly the same ticks as one big step."""
+        if not (isinstance(dt_s, (int, float)) and math.isfinite(dt_s) and dt_s >= 0):
+            raise SimulationError(
+                f"step(dt) needs a finite, non-negative dt in seconds, got {dt_s!r}"
+            )
+        self._target_ns += round(dt_s * NS_PER_S)
+        published: list[Published] = []
+        while self._now_ns + self._tick_ns <= self._target_ns:
+            self._tick()
+            published.extend(self._publish_due())
+        return published
+
+    def _tick(self) -> None:
+        dt = self._tick_s
+        state = self.state
+        geometry = self.robot.geometry
+        left, right = self.motors.step(dt)
+        linear, angular = body_velocities(left, right, geometry.wheel_radius_m, geometry.track_m)
+        pose = state.pose
+        x, y, yaw = integrate_arc(pose.x, pose.y, pose.yaw, linear, angular, dt)
+        x, y = self._resolve_contacts(pose.x, pose.y, x, y)
+        state.distance_travelled_m += math.hypot(x - pose.x, y - pose.y)
+        pose.x, pose.y, pose.yaw = x, y, yaw
+        state.linear_m_s, state.angular_rad_s = linear, angular
+        state.wheel_left_rad_s, state.wheel_right_rad_s = left, right
+        state.wheel_left_travel_rad += left * dt
+        state.wheel_right_travel_rad += right * dt
+        # Dead reckoning with the (miscalibrated) radii, wheels slipping against walls included.
+        odom_v, odom_w = body_velocities(
+            left * self._odom_left_radius / geometry.wheel_radius_m,
+            right * self._odom_right_radius / geometry.wheel_radius_m,
+            geometry.wheel_radius_m,
+            geometry.track_m,
+        )
+        odom = state.odometry_pose
+        odom.x, odom.y, odom.yaw = integrate_arc(odom.x, odom.y, odom.yaw, odom_v, odom_w, dt)
+        self._now_ns += self._tick_ns
+        self.robot.advance(state, dt, self.time_s)
+        self._track_bounds(x, y, dt)
+
+    def _resolve_contacts(
+        self, old_x: float, old_y: float, x: float, y: float
+    ) -> tuple[float, float]:
+        """Push the body out of anything it overlaps; count contacts as they begin.
+
+        A distance query costs tens of microseconds, so it only runs when the robot has used
+        up its last known clearance (conservative advancement): exact, and free in open space."""
+        radius = self.robot.geometry.body_radius_m
+        self._clearance_m -= math.hypot(x - old_x, y - old_y)
+        if self._clearance_m > 0.0:
+            if self.state.in_contact:
+                self._set_contact(False, (), x, y)
+            return x, y
+        angles: np.ndarray = np.zeros(0)
+        for _ in range(_COLLISION_ITERATIONS):
+            push, touching = self.obstacles.penetrations(x, y, radius)
+            if len(push) == 0:
+                break
+            if len(angles) == 0:
+                angles = touching
+            # Resolve the deepest overlap first; a corner's second wall is the next pass.
+            # (Summing would push twice at a box corner, where two edges share the point.)
+            deepest = int(np.argmax(np.hypot(push[:, 0], push[:, 1])))
+            x += float(push[deepest, 0])
+            y += float(push[deepest, 1])
+        # Margin of 0.5 mm so a robot resting against a wall keeps reporting the contact.
+        self._clearance_m = self.obstacles.clearance(x, y) - radius - 0.0005
+        robot_frame = tuple(wrap_angle(float(a) - self.state.pose.yaw) for a in angles)
+        self._set_contact(len(angles) > 0, robot_frame, x, y)
+        return x, y
+
+    def _set_contact(self, touching: bool, angles: tuple[float, ...], x: float, y: float) -> None:
+        state = self.state
+        if touching and not state.in_contact:
+            state.contact_count += 1
+            self._events.append(SimEvent(EventKind.CONTACT_BEGAN, self.time_s, x, y))
+        elif not touching and state.in_contact:
+            self._events.append(SimEvent(EventKind.CONTACT_ENDED, self.time_s, x, y))
+        state.in_contact = touching
+        state.contact_angles_rad = angles
+
+    def _inside_bounds(self, x: float, y: float) -> bool:
+        min_x, min_y, max_x, max_y = self.world.bounds
+        return min_x <= x <= max_x and min_y <= y <= max_y
+
+    def _track_bounds(self, x: float, y: float, dt: float) -> None:
+        outside = not self._inside_bounds(x, y)
+        if outside:
+            self.state.time_out_of_bounds_s += dt
+        if outside != self._out_of_bounds:
+            kind = EventKind.LEFT_BOUNDS if outside else EventKind.ENTERED_BOUNDS
+            self._events.append(SimEvent(kind, self.time_s, x, y))
+            self._out_of_bounds = outside
+
+    def _publish_due(self) -> list[Published]:
+        now = self._now_ns
+        due = [name for name, when in self._next_due_ns.items() if when <= now]
+        if not due:
+            return []
+        ctx = SenseContext(self.world, self.obstacles, self.state, self.time_s, self.lights)
+        published = []
+        for name in due:
+            message = self.sensors[name].sample(ctx, self._rngs[name])
+            self._latest[name] = message
+            published.append(Published(name, self.time_s, message))
+            period = self._period_ns[name]
+            # Skip slots a coarse tick jumped over instead of publishing a burst of duplicates.
+            behind = (now - self._next_due_ns[name]) // period + 1
+            self._next_due_ns[name] += behind * period
+        return published
+
+    # ----------------------------------------------------------------------------- drawing
+    def scene(self) -> Scene:
+        state = self.state
+        return Scene(
+            time_s=self.time_s,
+            robot_id=self.robot.id,
+            world_id=self.world.id,
+            pose=Pose2D(state.pose.x, state.pose.y, state.pose.yaw),
+            leds_rgb=state.leds_rgb,
+            buzzer_on=state.buzzer_on,
+            servo_angle_deg=state.servo_angle_deg,
+            in_contact=state.in_contact,
+            lights=self.lights,
+            latest=dict(self._latest),
+        )
