@@ -1,0 +1,103 @@
+"""One message with non-default values for every registered type, shared by the tests.
+
+float32 fields use values exact in single precision so round trips compare equal.
+"""
+
+from collections.abc import Callable
+
+from sandbox.msgs import Duration, Message, Time, geometry_msgs, nav_msgs, sensor_msgs, std_msgs
+
+
+def header(seq: int = 7) -> std_msgs.Header:
+    return std_msgs.Header(seq=seq, stamp=Time(1_700_000_000, 123_456_789), frame_id="base_link")
+
+
+def _pose(x: float) -> geometry_msgs.Pose:
+    return geometry_msgs.Pose(
+        geometry_msgs.Point(x, -2.5, 0.125), geometry_msgs.Quaternion(0.0, 0.0, 0.6, 0.8)
+    )
+
+
+def _twist() -> geometry_msgs.Twist:
+    return geometry_msgs.Twist(geometry_msgs.Vector3(0.3, 0, 0), geometry_msgs.Vector3(0, 0, -1.25))
+
+
+def _layout() -> std_msgs.MultiArrayLayout:
+    return std_msgs.MultiArrayLayout(
+        dim=[
+            std_msgs.MultiArrayDimension("rows", 2, 6),
+            std_msgs.MultiArrayDimension("cölumns ✓", 3, 3),
+        ],
+        data_offset=1,
+    )
+
+
+SAMPLES: dict[str, Callable[[], Message]] = {
+    "std_msgs/Header": header,
+    "std_msgs/Bool": lambda: std_msgs.Bool(True),
+    "std_msgs/Int16": lambda: std_msgs.Int16(-32768),
+    "std_msgs/Int32": lambda: std_msgs.Int32(2_147_483_647),
+    "std_msgs/Float32": lambda: std_msgs.Float32(0.5),
+    "std_msgs/Float64": lambda: std_msgs.Float64(-1e300),
+    "std_msgs/String": lambda: std_msgs.String("héllo, 世界 🤖"),
+    "std_msgs/Empty": std_msgs.Empty,
+    "std_msgs/Time": lambda: std_msgs.Time(Time(5, 6)),
+    "std_msgs/Duration": lambda: std_msgs.Duration(Duration(-5, 6)),
+    "std_msgs/ColorRGBA": lambda: std_msgs.ColorRGBA(1.0, 0.5, 0.25, 0.125),
+    "std_msgs/MultiArrayDimension": lambda: std_msgs.MultiArrayDimension("x", 4, 4),
+    "std_msgs/MultiArrayLayout": _layout,
+    "std_msgs/Int32MultiArray": lambda: std_msgs.Int32MultiArray(_layout(), [1, -2, 3, 4, 5, 6]),
+    "std_msgs/Float32MultiArray": lambda: std_msgs.Float32MultiArray(_layout(), [0.5, -0.25]),
+    "geometry_msgs/Vector3": lambda: geometry_msgs.Vector3(1.5, -2.0, 3.25),
+    "geometry_msgs/Point": lambda: geometry_msgs.Point(z=9.0),
+    "geometry_msgs/Quaternion": lambda: geometry_msgs.Quaternion(w=1.0),
+    "geometry_msgs/Pose": lambda: _pose(1.0),
+    "geometry_msgs/Pose2D": lambda: geometry_msgs.Pose2D(1.0, 2.0, 3.0),
+    "geometry_msgs/PoseStamped": lambda: geometry_msgs.PoseStamped(header(), _pose(2.0)),
+    "geometry_msgs/PoseWithCovariance": lambda: geometry_msgs.PoseWithCovariance(
+        _pose(3.0), [float(i) for i in range(36)]
+    ),
+    "geometry_msgs/Twist": _twist,
+    "geometry_msgs/TwistWithCovariance": lambda: geometry_msgs.TwistWithCovariance(
+        _twist(), [0.01 * i for i in range(36)]
+    ),
+    "sensor_msgs/LaserScan": lambda: sensor_msgs.LaserScan(
+        header=header(),
+        angle_min=-1.5,
+        angle_max=1.5,
+        angle_increment=0.25,
+        time_increment=2.0**-10,
+        scan_time=0.125,
+        range_min=0.0625,
+        range_max=8.0,
+        ranges=[0.5, 1.0, float("inf"), 2.0],
+        intensities=[10.0, 20.0, 0.0, 5.0],
+    ),
+    "sensor_msgs/Imu": lambda: sensor_msgs.Imu(
+        header(),
+        geometry_msgs.Quaternion(0, 0, 0, 1),
+        [1.0] * 9,
+        geometry_msgs.Vector3(0.1, 0.2, 0.3),
+        [2.0] * 9,
+        geometry_msgs.Vector3(0, 0, 9.81),
+        [-1.0] + [0.0] * 8,
+    ),
+    "sensor_msgs/Range": lambda: sensor_msgs.Range(
+        header(), sensor_msgs.Range.INFRARED, 0.5, 0.03125, 4.0, 1.25
+    ),
+    "nav_msgs/MapMetaData": lambda: nav_msgs.MapMetaData(Time(3, 4), 0.0625, 4, 2, _pose(-1.0)),
+    "nav_msgs/OccupancyGrid": lambda: nav_msgs.OccupancyGrid(
+        header(),
+        nav_msgs.MapMetaData(Time(3, 4), 0.0625, 4, 2, _pose(-1.0)),
+        [-1, 0, 100, 50, -1, 0, 127, -128],
+    ),
+    "nav_msgs/Odometry": lambda: nav_msgs.Odometry(
+        header(),
+        "base_footprint",
+        geometry_msgs.PoseWithCovariance(_pose(4.0), [0.5] * 36),
+        geometry_msgs.TwistWithCovariance(_twist(), [0.25] * 36),
+    ),
+    "nav_msgs/Path": lambda: nav_msgs.Path(
+        header(), [geometry_msgs.PoseStamped(header(i), _pose(float(i))) for i in range(3)]
+    ),
+}
