@@ -19,6 +19,9 @@ _STRAIGHT_EPS = 1e-9  # [rad] |w dt| below this the arc is a straight line (avoi
 
 def wrap_angle(angle_rad: float) -> float:
     """Wrap an angle to (-pi, pi]."""
+    # Fast path: after one physics tick the angle is at most slightly outside the range.
+    if -math.pi < angle_rad <= math.pi:
+        return angle_rad
     wrapped = math.fmod(angle_rad + math.pi, 2.0 * math.pi)
     if wrapped <= 0.0:
         wrapped += 2.0 * math.pi

@@ -156,12 +156,15 @@ class Simulation:
         self.sensors: dict[str, Sensor] = self.robot.build_sensors()
         self._rngs = {name: _topic_rng(self.seed, name) for name in self.sensors}
         physics_rng = _topic_rng(self.seed, "__physics__")
-        radius = self.robot.geometry.wheel_radius_m
-        self._odom_left_radius, self._odom_right_radius = radius * (
+        self._wheel_radius_m = self.robot.geometry.wheel_radius_m
+        self._track_m = self.robot.geometry.track_m
+        # Effective/nominal radius of each wheel as dead reckoning wrongly assumes it.
+        self._odom_left_scale, self._odom_right_scale = (
             1.0 + physics_rng.normal(0.0, ODOMETRY_RADIUS_ERROR, 2)
-        )
+        ).tolist()
         self._period_ns = {n: round(NS_PER_S / s.rate_hz) for n, s in self.sensors.items()}
         self._next_due_ns = {n: round(s.phase_s * NS_PER_S) for n, s in self.sensors.items()}
+        self._earliest_due_ns = min(self._next_due_ns.values())
         for sensor in self.sensors.values():
             sensor.reset()
         self._now_ns = 0
@@ -272,9 +275,9 @@ class Simulation:
     def _tick(self) -> None:
         dt = self._tick_s
         state = self.state
-        geometry = self.robot.geometry
+        wheel_radius, track = self._wheel_radius_m, self._track_m
         left, right = self.motors.step(dt)
-        linear, angular = body_velocities(left, right, geometry.wheel_radius_m, geometry.track_m)
+        linear, angular = body_velocities(left, right, wheel_radius, track)
         pose = state.pose
         x, y, yaw = integrate_arc(pose.x, pose.y, pose.yaw, linear, angular, dt)
         x, y = self._resolve_contacts(pose.x, pose.y, x, y)
@@ -286,16 +289,15 @@ class Simulation:
         state.wheel_right_travel_rad += right * dt
         # Dead reckoning with the (miscalibrated) radii, wheels slipping against walls included.
         odom_v, odom_w = body_velocities(
-            left * self._odom_left_radius / geometry.wheel_radius_m,
-            right * self._odom_right_radius / geometry.wheel_radius_m,
-            geometry.wheel_radius_m,
-            geometry.track_m,
+            left * self._odom_left_scale, right * self._odom_right_scale, wheel_radius, track
         )
         odom = state.odometry_pose
         odom.x, odom.y, odom.yaw = integrate_arc(odom.x, odom.y, odom.yaw, odom_v, odom_w, dt)
         self._now_ns += self._tick_ns
-        self.robot.advance(state, dt, self.time_s)
-        self._track_bounds(x, y, dt)
+        self.robot.advance(state, dt, self._now_ns / NS_PER_S)
+        min_x, min_y, max_x, max_y = self.world.bounds
+        if self._out_of_bounds or not (min_x <= x <= max_x and min_y <= y <= max_y):
+            self._track_bounds(x, y, dt)
 
     def _resolve_contacts(
         self, old_x: float, old_y: float, x: float, y: float
@@ -353,9 +355,9 @@ class Simulation:
 
     def _publish_due(self) -> list[Published]:
         now = self._now_ns
-        due = [name for name, when in self._next_due_ns.items() if when <= now]
-        if not due:
+        if now < self._earliest_due_ns:
             return []
+        due = [name for name, when in self._next_due_ns.items() if when <= now]
         ctx = SenseContext(self.world, self.obstacles, self.state, self.time_s, self.lights)
         published = []
         for name in due:
@@ -366,6 +368,7 @@ class Simulation:
             # Skip slots a coarse tick jumped over instead of publishing a burst of duplicates.
             behind = (now - self._next_due_ns[name]) // period + 1
             self._next_due_ns[name] += behind * period
+        self._earliest_due_ns = min(self._next_due_ns.values())
         return published
 
     # ----------------------------------------------------------------------------- drawing
