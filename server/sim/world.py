@@ -1,14 +1,47 @@
 """Worlds: declarative TOML files, validated on load, compiled to numpy arrays for the sensors.
 
-INTERFACE STUB (the loader, validation and registry are being written; the compiled shapes below
-are the contract the physics and sensors code against).
+A world is `server/sim/worlds/<id>.toml` (the format and its checks live in
+`server.sim.world_file`). `load_world(id)` reads, checks and compiles it once and caches the
+immutable `World` (its arrays are read-only, so runs can share it). `check_world` is the validator
+the tests run over every registered world. Pure: the only I/O is reading the packaged world files.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import functools
+import math
+import os
+import tomllib
+from dataclasses import dataclass, field
+from importlib import resources
+from typing import Any
 
 import numpy as np
+
+from server.sim.world_file import (
+    KNOWN_ROBOT_IDS,
+    MAP_CELL_CHARS,
+    WorldError,
+    WorldSpec,
+    parse_world_spec,
+)
+
+__all__ = [
+    "KNOWN_ROBOT_IDS",
+    "GridMap",
+    "LightSource",
+    "Spawn",
+    "World",
+    "WorldError",
+    "check_world",
+    "load_world",
+    "load_world_file",
+    "parse_world",
+    "world_ids",
+]
+
+_WORLDS_PACKAGE = "server.sim.worlds"
+MAP_FREE, MAP_OCCUPIED, MAP_UNKNOWN = 0, 100, -1  # nav_msgs/OccupancyGrid cell values
 
 
 @dataclass(frozen=True, slots=True)
@@ -65,6 +98,9 @@ class World:
     - `ambient_light`: [0, 1] fraction of a light sensor's full scale from room light.
     - `floor_reflectance`: [0, 1] how bright the bare floor is to the line sensors.
     - `spawns`: named start poses; the first is the default.
+    - `circle_kind`: (M,) "plant" or "post" per circle (empty for hand-built worlds).
+    - `boxes`: (K, 6) float64 rows (cx, cy, width, depth, yaw [rad], height [m]): the solid boxes
+      whose edges are in `segments`, for drawing and inside-tests.
     """
 
     id: str
@@ -84,3 +120,260 @@ class World:
     floor_reflectance: float
     grid_map: GridMap | None
     robots: tuple[str, ...]  # robot ids that make sense in this world (the registry checks them)
+    circle_kind: tuple[str, ...] = ()
+    boxes: np.ndarray = field(default_factory=lambda: np.zeros((0, 6)))
+
+    def spawn(self, name: str | None = None) -> Spawn:
+        """The spawn called `name`, or the default (first) one."""
+        if name is None:
+            return self.spawns[0]
+        for spawn in self.spawns:
+            if spawn.name == name:
+                return spawn
+        valid = ", ".join(s.name for s in self.spawns)
+        raise WorldError(f"world {self.id!r}: no spawn named {name!r} (valid: {valid})")
+
+    def clearance(self, x: float, y: float) -> float:
+        """Distance [m] from (x, y) to the nearest wall, box edge or cylinder surface; negative
+        inside a box or cylinder, inf in an empty world. A disc robot of radius r fits if >= r."""
+        point = np.array([x, y], dtype=float)
+        nearest = math.inf
+        if len(self.segments):
+            nearest = float(_point_segment_distance(point, self.segments).min())
+        if len(self.circles):
+            gaps = np.hypot(*(self.circles[:, :2] - point).T) - self.circles[:, 2]
+            nearest = min(nearest, float(gaps.min()))
+        for cx, cy, width, depth, yaw, _height in self.boxes:
+            c, s = math.cos(yaw), math.sin(yaw)
+            u, v = c * (x - cx) + s * (y - cy), -s * (x - cx) + c * (y - cy)
+            inside = min(width / 2 - abs(u), depth / 2 - abs(v))
+            if inside > 0:
+                nearest = min(nearest, -inside)
+        return nearest
+
+    def in_bounds(self, x: float, y: float) -> bool:
+        """Whether (x, y) [m] lies within `bounds` (edges included)."""
+        min_x, min_y, max_x, max_y = self.bounds
+        return min_x <= x <= max_x and min_y <= y <= max_y
+
+
+def _point_segment_distance(point: np.ndarray, segments: np.ndarray) -> np.ndarray:
+    """Distances [m] from one point to each (x1, y1, x2, y2) row."""
+    start, delta = segments[:, :2], segments[:, 2:] - segments[:, :2]
+    length_sq = np.maximum((delta**2).sum(axis=1), 1e-18)
+    t = np.clip(((point - start) * delta).sum(axis=1) / length_sq, 0.0, 1.0)
+    closest = start + t[:, None] * delta
+    return np.hypot(*(closest - point).T)
+
+
+def rasterize(
+    segments: np.ndarray,
+    circles: np.ndarray,
+    boxes: np.ndarray,
+    bounds: tuple[float, float, float, float],
+    resolution: float,
+    origin: tuple[float, float, float],
+    width: int,
+    height: int,
+) -> np.ndarray:
+    """An occupancy grid (height, width) int8 of the geometry: 100 where a wall, box edge or
+    cylinder touches the cell's square or the centre is inside a box (a desk is solid on a map),
+    -1 where the cell centre is outside `bounds`, else 0.
+
+    Touching the square (not only passing near the centre) keeps a thin diagonal wall a closed
+    barrier in the grid, so a planner cannot slip through it corner to corner.
+    """
+    ox, oy, oyaw = origin
+    c, s = math.cos(oyaw), math.sin(oyaw)
+    half = resolution / 2
+
+    def to_map(xy: np.ndarray) -> np.ndarray:  # world (..., 2) -> map frame, metres
+        dx, dy = xy[..., 0] - ox, xy[..., 1] - oy
+        return np.stack([c * dx + s * dy, -s * dx + c * dy], axis=-1)
+
+    grid = np.zeros((height, width), dtype=np.int8)
+
+    def window(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+        i0, j0 = np.floor(lo / resolution).astype(int) - 1
+        i1, j1 = np.floor(hi / resolution).astype(int) + 1
+        i0, j0, i1, j1 = max(i0, 0), max(j0, 0), min(i1, width - 1), min(j1, height - 1)
+        if i0 > i1 or j0 > j1:
+            return None
+        return np.meshgrid(np.arange(i0, i1 + 1), np.arange(j0, j1 + 1))
+
+    for x1, y1, x2, y2 in segments:
+        p, q = to_map(np.array([x1, y1])), to_map(np.array([x2, y2]))
+        cells = window(np.minimum(p, q), np.maximum(p, q))
+        if cells is None:
+            continue
+        ii, jj = cells
+        cx, cy = (ii + 0.5) * resolution, (jj + 0.5) * resolution
+        nx, ny = -(q[1] - p[1]), q[0] - p[0]  # separating-axis test, segment vs cell square
+        touch = (
+            (np.minimum(p[0], q[0]) <= cx + half)
+            & (np.maximum(p[0], q[0]) >= cx - half)
+            & (np.minimum(p[1], q[1]) <= cy + half)
+            & (np.maximum(p[1], q[1]) >= cy - half)
+            & (np.abs(nx * (cx - p[0]) + ny * (cy - p[1])) <= half * (abs(nx) + abs(ny)) + 1e-12)
+        )
+        grid[jj[touch], ii[touch]] = MAP_OCCUPIED
+    for x, y, radius in circles:
+        centre = to_map(np.array([x, y]))
+        cells = window(centre - radius, centre + radius)
+        if cells is None:
+            continue
+        ii, jj = cells
+        dx = np.maximum(np.abs((ii + 0.5) * resolution - centre[0]) - half, 0.0)
+        dy = np.maximum(np.abs((jj + 0.5) * resolution - centre[1]) - half, 0.0)
+        touch = np.hypot(dx, dy) <= radius
+        grid[jj[touch], ii[touch]] = MAP_OCCUPIED
+    ii, jj = np.meshgrid(np.arange(width), np.arange(height))
+    u, v = (ii + 0.5) * resolution, (jj + 0.5) * resolution
+    wx, wy = ox + c * u - s * v, oy + s * u + c * v
+    for bx, by, box_width, box_depth, box_yaw, _height in boxes:
+        bc, bs = math.cos(box_yaw), math.sin(box_yaw)
+        along, across = bc * (wx - bx) + bs * (wy - by), -bs * (wx - bx) + bc * (wy - by)
+        grid[(np.abs(along) <= box_width / 2) & (np.abs(across) <= box_depth / 2)] = MAP_OCCUPIED
+    outside = (wx < bounds[0]) | (wx > bounds[2]) | (wy < bounds[1]) | (wy > bounds[3])
+    grid[outside] = MAP_UNKNOWN
+    return grid
+
+
+def _frozen(rows: list, columns: int) -> np.ndarray:
+    array = np.array(rows, dtype=np.float64).reshape(-1, columns)
+    array.flags.writeable = False
+    return array
+
+
+def compile_world(spec: WorldSpec) -> World:
+    """Turn a checked `WorldSpec` into the immutable `World` the simulator reads."""
+    segments = _frozen([s[:4] for s in spec.segments], 4)
+    circles = _frozen([c[:3] for c in spec.circles], 3)
+    boxes = _frozen(spec.boxes, 6)
+    grid_map = None
+    if spec.map is not None:
+        m = spec.map
+        if m["rows"] is not None:
+            cells = [[MAP_CELL_CHARS[ch] for ch in row] for row in reversed(m["rows"])]
+            data = np.array(cells, dtype=np.int8)
+        else:
+            args = (spec.bounds, m["resolution"], m["origin"], m["width"], m["height"])
+            data = rasterize(segments, circles, boxes, *args)
+        data.flags.writeable = False
+        grid_map = GridMap(m["resolution"], *m["origin"], m["width"], m["height"], data)
+    return World(
+        id=spec.id,
+        title=spec.title,
+        description=spec.description,
+        segments=segments,
+        segment_height=_frozen([s[4] for s in spec.segments], 1).ravel(),
+        circles=circles,
+        circle_height=_frozen([c[3] for c in spec.circles], 1).ravel(),
+        tape_segments=_frozen([t[:4] for t in spec.tape], 4),
+        tape_width=_frozen([t[4] for t in spec.tape], 1).ravel(),
+        tape_darkness=_frozen([t[5] for t in spec.tape], 1).ravel(),
+        lights=tuple(LightSource(*light) for light in spec.lights),
+        spawns=tuple(Spawn(*spawn) for spawn in spec.spawns),
+        bounds=spec.bounds,
+        ambient_light=spec.ambient_light,
+        floor_reflectance=spec.floor_reflectance,
+        grid_map=grid_map,
+        robots=spec.robots,
+        circle_kind=tuple(c[4] for c in spec.circles),
+        boxes=boxes,
+    )
+
+
+def parse_world(
+    data: dict[str, Any], source: str = "<dict>", known_robot_ids: tuple[str, ...] = KNOWN_ROBOT_IDS
+) -> World:
+    """Check and compile a world file's dict as `tomllib` reads it; `source` names it in errors."""
+    return compile_world(parse_world_spec(data, source, known_robot_ids))
+
+
+def _parse_toml(text: bytes, file_name: str) -> World:
+    try:
+        data = tomllib.loads(text.decode("utf-8"))
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as error:
+        raise WorldError(f"world file {file_name}: not valid TOML: {error}") from None
+    stem = file_name.rsplit("/", 1)[-1].removesuffix(".toml")
+    if "id" in data and data["id"] != stem:
+        raise WorldError(
+            f"world file {file_name}: id {data['id']!r} does not match the file name; "
+            f"set id = {stem!r} or rename the file to {data['id']}.toml"
+        )
+    return parse_world(data, file_name)
+
+
+def load_world_file(path: str | os.PathLike[str]) -> World:
+    """Read, check and compile one world file; its `id` must equal the file name's stem."""
+    with open(path, "rb") as handle:
+        return _parse_toml(handle.read(), os.fspath(path))
+
+
+def world_ids() -> tuple[str, ...]:
+    """The ids of the packaged worlds (`server/sim/worlds/*.toml`), sorted."""
+    files = resources.files(_WORLDS_PACKAGE).iterdir()
+    return tuple(sorted(f.name.removesuffix(".toml") for f in files if f.name.endswith(".toml")))
+
+
+@functools.cache
+def load_world(world_id: str) -> World:
+    """The packaged world `world_id`, checked and compiled once, then shared (it is immutable)."""
+    valid = world_ids()
+    if world_id not in valid:
+        raise WorldError(f"unknown world {world_id!r} (valid ids: {', '.join(valid)})")
+    resource = resources.files(_WORLDS_PACKAGE).joinpath(f"{world_id}.toml")
+    return _parse_toml(resource.read_bytes(), f"{world_id}.toml")
+
+
+def check_world(world: World, robot_radius: float = 0.1) -> None:
+    """The registry's validator: raise `WorldError` listing every broken invariant of `world`.
+
+    Arrays have their documented shapes and are finite; heights, widths and radii are positive;
+    spawns, lights and tape lie inside the bounds; every spawn leaves `robot_radius` [m] of
+    clearance; robots are known; a map's data matches its width and height.
+    """
+    problems = []
+    shapes = {
+        "segments": (world.segments, 4),
+        "circles": (world.circles, 3),
+        "tape_segments": (world.tape_segments, 4),
+        "boxes": (world.boxes, 6),
+    }
+    for name, (array, columns) in shapes.items():
+        if array.ndim != 2 or array.shape[1] != columns or not np.isfinite(array).all():
+            problems.append(f"{name} must be a finite (N, {columns}) array, got {array.shape}")
+    per_row = {
+        "segment_height": len(world.segments),
+        "circle_height": len(world.circles),
+        "tape_width": len(world.tape_segments),
+        "tape_darkness": len(world.tape_segments),
+    }
+    for name, rows in per_row.items():
+        values = getattr(world, name)
+        if values.shape != (rows,) or not np.isfinite(values).all():
+            problems.append(f"{name} must be a finite ({rows},) array, got {values.shape}")
+    if (world.segment_height <= 0).any() or (world.circles[:, 2] <= 0).any():
+        problems.append("every segment height and circle radius must be > 0")
+    if world.circle_kind and len(world.circle_kind) != len(world.circles):
+        problems.append("circle_kind must name one kind per circle")
+    for spawn in world.spawns:
+        if not world.in_bounds(spawn.x, spawn.y):
+            problems.append(f"spawn {spawn.name!r} is outside the bounds")
+        elif (gap := world.clearance(spawn.x, spawn.y)) < robot_radius:
+            problems.append(
+                f"spawn {spawn.name!r} has {gap:.3f} m clearance, less than {robot_radius} m"
+            )
+    for light in world.lights:
+        if not world.in_bounds(light.x, light.y):
+            problems.append(f"light {light.name!r} is outside the bounds")
+    ends = world.tape_segments.reshape(-1, 2)
+    if not all(world.in_bounds(x, y) for x, y in ends):
+        problems.append("tape leaves the bounds")
+    problems += [f"unknown robot id {r!r}" for r in world.robots if r not in KNOWN_ROBOT_IDS]
+    grid = world.grid_map
+    if grid is not None and grid.data.shape != (grid.height, grid.width):
+        problems.append(f"grid_map.data shape {grid.data.shape} != ({grid.height}, {grid.width})")
+    if problems:
+        raise WorldError(f"world {world.id!r}: " + "; ".join(problems))
