@@ -85,6 +85,7 @@ class Scene:
     in_contact: bool
     lights: tuple[LightSource, ...]
     latest: dict[str, object]
+    rays: dict[str, np.ndarray]  # topic -> (K, 4) world segments of what the sensor measured
 
 
 def _topic_rng(seed: int, topic: str) -> np.random.Generator:
@@ -385,4 +386,14 @@ class Simulation:
             in_contact=state.in_contact,
             lights=self.lights,
             latest=dict(self._latest),
+            rays=self._rays(),
         )
+
+    def _rays(self) -> dict[str, np.ndarray]:
+        ctx = SenseContext(self.world, self.obstacles, self.state, self.time_s, self.lights)
+        rays = {}
+        for name, sensor in self.sensors.items():
+            message = self._latest.get(name)
+            if message is not None and hasattr(sensor, "rays"):
+                rays[name] = sensor.rays(ctx, message)
+        return rays

@@ -241,3 +241,15 @@ def test_scene_carries_what_the_view_draws():
     assert scene.robot_id == "crop_rover" and scene.world_id == "crop_rows"
     assert set(scene.latest) >= {"scan", "psi", "imu", "odom"}
     assert np.isfinite([scene.pose.x, scene.pose.y, scene.pose.yaw]).all()
+
+
+def test_scene_rays_end_where_the_sensor_measured():
+    sim = Simulation("crowbot", "wall_approach", seed=0)
+    sim.step(0.1)
+    rays = sim.scene().rays["Distance"]
+    assert rays.shape == (3, 4)  # cone edge, axis, cone edge
+    axis_end_x = rays[1, 2]
+    assert axis_end_x == pytest.approx(1.4, abs=0.015)  # the board's face
+    ir = Simulation("ir_scout", "wall_approach", seed=0)
+    ir.step(0.1)
+    assert ir.scene().rays["ir_range"].shape == (1, 4)

@@ -11,9 +11,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Protocol
 
-if TYPE_CHECKING:
-    import numpy as np
+import numpy as np
 
+if TYPE_CHECKING:
     from server.sim.obstacles import Obstacles
     from server.sim.state import RobotState
     from server.sim.world import LightSource, World
@@ -48,6 +48,31 @@ class Sensor(Protocol):
     def sample(self, ctx: SenseContext, rng: np.random.Generator) -> object:
         """Return one message of `msg_type` for the state in `ctx`."""
         ...
+
+
+class DrawsRays(Protocol):
+    """A sensor that can show what it measured: `rays(ctx, message)` returns world-frame line
+    segments (K, 4) rows (x1, y1, x2, y2) [m] for the 3D view (a beam, a cone's edges, scan
+    points as short rays)."""
+
+    def rays(self, ctx: SenseContext, message: object) -> np.ndarray: ...
+
+
+def fan(
+    origin_x: float, origin_y: float, headings_rad: np.ndarray, lengths_m: np.ndarray
+) -> np.ndarray:
+    """Rays from one origin: (K, 4) segments along `headings_rad`, each `lengths_m` long."""
+    headings = np.asarray(headings_rad, dtype=np.float64)
+    lengths = np.broadcast_to(np.asarray(lengths_m, dtype=np.float64), headings.shape)
+    return np.stack(
+        [
+            np.full(headings.shape, origin_x),
+            np.full(headings.shape, origin_y),
+            origin_x + lengths * np.cos(headings),
+            origin_y + lengths * np.sin(headings),
+        ],
+        axis=1,
+    )
 
 
 class StatelessSensor:

@@ -33,7 +33,7 @@ import numpy as np
 from sandbox.msgs import Time
 from sandbox.msgs.sensor_msgs import Range
 from sandbox.msgs.std_msgs import Header, Int32
-from server.sim.sensors.base import SenseContext, StatelessSensor
+from server.sim.sensors.base import SenseContext, StatelessSensor, fan
 from server.sim.sensors.mount import Mount
 
 MIN_RANGE_M = 0.10
@@ -69,10 +69,14 @@ class IrMeasurement:
         self.mount = mount
         self._offsets = np.linspace(-BEAM_FULL_ANGLE_RAD / 2, BEAM_FULL_ANGLE_RAD / 2, BEAM_RAYS)
 
+    def beam_origin(self, ctx: SenseContext) -> tuple[float, float, float]:
+        """World (x, y [m], heading [rad]) of the beam, turned by the servo."""
+        servo_rad = math.radians(ctx.state.servo_angle_deg - SERVO_CENTRE_DEG)
+        return self.mount.in_world(ctx.state.pose, servo_rad)
+
     def true_range_m(self, ctx: SenseContext) -> float:
         """Range [m] to a surface the beam can see, inf when nothing answers."""
-        servo_rad = math.radians(ctx.state.servo_angle_deg - SERVO_CENTRE_DEG)
-        x, y, heading = self.mount.in_world(ctx.state.pose, servo_rad)
+        x, y, heading = self.beam_origin(ctx)
         hits = ctx.obstacles.cast(np.array([x, y]), heading + self._offsets, MAX_RANGE_M * 1.5)
         seen = hits.incidence_rad <= GRAZING_MISS_INCIDENCE_RAD
         nearest = float(np.where(seen, hits.distance_m, np.inf).min())
@@ -127,3 +131,9 @@ class IrRange(StatelessSensor):
             max_range=MAX_RANGE_M,
             range=range_m,
         )
+
+    def rays(self, ctx: SenseContext, message: Range) -> np.ndarray:
+        """The beam, as long as the reading (full range when nothing answered)."""
+        x, y, heading = self.measurement.beam_origin(ctx)
+        length = message.range if math.isfinite(message.range) else MAX_RANGE_M
+        return fan(x, y, np.array([heading]), length)

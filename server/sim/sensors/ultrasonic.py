@@ -23,7 +23,7 @@ import math
 import numpy as np
 
 from sandbox.msgs.std_msgs import Int32
-from server.sim.sensors.base import SenseContext, StatelessSensor
+from server.sim.sensors.base import SenseContext, StatelessSensor, fan
 from server.sim.sensors.mount import Mount
 
 SPEED_OF_SOUND_M_S = 343.0  # [m/s]
@@ -61,3 +61,10 @@ class UltrasonicRanger(StatelessSensor):
             return Int32(data=0)
         echo_us = 2.0 * distance_m / SPEED_OF_SOUND_M_S * 1e6 + rng.normal(0.0, ECHO_JITTER_US)
         return Int32(data=max(0, int(echo_us // ECHO_US_PER_CM)))
+
+    def rays(self, ctx: SenseContext, message: Int32) -> np.ndarray:
+        """The cone's axis and edges, as long as the reading (full range when no echo)."""
+        x, y, heading = self.mount.in_world(ctx.state.pose)
+        length = message.data / 100.0 if message.data > 0 else MAX_RANGE_M
+        edges = np.array([-CONE_FULL_ANGLE_RAD / 2, 0.0, CONE_FULL_ANGLE_RAD / 2])
+        return fan(x, y, heading + edges, length)
