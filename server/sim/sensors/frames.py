@@ -1,0 +1,43 @@
+"""Small frame and message helpers shared by the sensors, so the math lives in one place
+(where a sensor sits on the robot is `server.sim.sensors.mount.Mount`).
+
+Conventions (REP 103): x forward, y left, yaw counter-clockwise from +x [rad]; angles are
+reported wrapped to (-pi, pi].
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from sandbox.msgs import Time
+from sandbox.msgs.geometry_msgs import Quaternion
+from sandbox.msgs.std_msgs import Header
+
+TWO_PI = 2.0 * math.pi
+
+
+def wrap_angle(angle_rad: float | np.ndarray) -> float | np.ndarray:
+    """Wrap an angle (or an array of angles) [rad] to (-pi, pi]."""
+    return angle_rad - TWO_PI * np.ceil((angle_rad - math.pi) / TWO_PI)
+
+
+def yaw_quaternion(yaw_rad: float) -> Quaternion:
+    """The unit quaternion of a rotation by `yaw_rad` about +z."""
+    half = 0.5 * float(yaw_rad)
+    return Quaternion(x=0.0, y=0.0, z=math.sin(half), w=math.cos(half))
+
+
+def stamped_header(time_s: float, frame_id: str) -> Header:
+    """A message header stamped with the simulated time [s]."""
+    return Header(stamp=Time.from_sec(float(time_s)), frame_id=frame_id)
+
+
+def diagonal_covariance(variances: tuple[float, ...]) -> list[float]:
+    """A row-major n x n covariance (ROS `float64[n*n]`) with `variances` on the diagonal."""
+    size = len(variances)
+    flat = [0.0] * (size * size)
+    for index, variance in enumerate(variances):
+        flat[index * size + index] = float(variance)
+    return flat
