@@ -1,4 +1,4 @@
-"""Kinematics and motor models: exact arcs, the paper's wheel transforms, the firmware's PWM path."""
+"""Kinematics and motor models: exact arcs, the wheel transforms, the firmware PWM path."""
 
 import math
 
@@ -98,3 +98,4 @@ def test_velocity_motors_clamp_each_wheel_and_limit_acceleration():
     for _ in range(100):
         left, right = motors.step(0.1)
     assert left * 0.036 == pytest.approx(0.5)  # per-wheel clamp at 0.5 m/s
+    assert right == left  # per-wheel clamp at 0.5 m/s

@@ -187,7 +187,7 @@ def test_wrong_message_type_names_topic_and_expected_type():
 
 def test_unknown_topic_and_publishing_to_a_sensor_topic_say_what_exists():
     sim = open_floor_crowbot()
-    with pytest.raises(SimulationError, match="Distance .*Control"):
+    with pytest.raises(SimulationError, match=r"Distance .*Control"):
         sim.apply("cmd_vel", twist(0.1))
     with pytest.raises(SimulationError, match="commands go to Control, Leds, Buzzer"):
         sim.apply("Distance", Int32(data=3))
