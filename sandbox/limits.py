@@ -1,0 +1,49 @@
+"""Every limit a sandboxed node runs under, in one table, each with the reason for its value.
+
+The launcher applies the process limits (rlimits, tmpfs size, step budget); the node host applies
+the artifact caps when it collects files; the parent applies the log caps while it drains the
+node's output. Change a value here and every layer follows.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+MiB = 1024 * 1024
+
+
+@dataclass(frozen=True, slots=True)
+class Limits:
+    # Address space. numpy + matplotlib + scikit-fuzzy map ~600 MiB of virtual memory (mostly
+    # untouched library mappings); 1.5 GiB leaves room for real arrays but stops a memory bomb
+    # long before it hurts the server or another run.
+    address_space_bytes: int = 1536 * MiB
+    # CPU seconds for the node's whole life: a run of several minutes at a few percent CPU fits
+    # easily; a spinning node is killed by the step budget long before this.
+    cpu_seconds: int = 900
+    # Open files: the interpreter, imports and a few figures; blocks descriptor exhaustion.
+    open_files: int = 128
+    # Largest single file the node may write [bytes]: a figure or a CSV, not a disk filler.
+    file_size_bytes: int = 16 * MiB
+    # Scratch directory (the node's working directory) is a tmpfs of this size; other nodes and
+    # the host never see it.
+    scratch_bytes: int = 64 * MiB
+    # Wall-clock time a node may compute between being woken and sleeping again. A controller
+    # that needs more than this per period is broken (or `while True: pass`).
+    step_budget_s: float = 2.0
+    # The first wake runs module-level code and setup(), which may import and precompute.
+    first_step_budget_s: float = 10.0
+    # How long an idle warm process may take to start and import numpy/matplotlib/skfuzzy.
+    startup_budget_s: float = 30.0
+    # After Shutdown, time to run on_shutdown hooks, save figures and send artifacts.
+    shutdown_budget_s: float = 10.0
+    # Artifacts collected from the scratch directory at the end of a run.
+    artifact_file_bytes: int = 8 * MiB
+    artifact_total_bytes: int = 24 * MiB
+    artifact_count: int = 32
+    # Log stream: what one node may print over a run; beyond it lines are dropped with a note.
+    log_total_bytes: int = 1 * MiB
+    log_line_bytes: int = 4096
+
+
+DEFAULT_LIMITS = Limits()

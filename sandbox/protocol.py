@@ -1,0 +1,218 @@
+"""The wire between the server (parent) and a sandboxed node (child).
+
+Frames are msgspec Structs, msgpack-encoded, each preceded by its length as a little-endian
+uint32, on two inherited pipes: one parent -> child, one child -> parent. The node's stdout and
+stderr are a third pipe (the log stream), so nothing the student prints can corrupt a frame.
+
+A node's life, as the parent sees it:
+
+    child:  Ready                                   (imports done, sandbox sealed, idle in pool)
+    parent: Load(code, info)
+    child:  Yield(wake_at, published, graph)         (setup ran; first sleep)
+    parent: Wake(time, deliveries)      <-- repeated: the node runs until it sleeps again
+    child:  Yield(...)
+    parent: Shutdown(reason)           (or the node ends by itself)
+    child:  Exited(outcome, error, artifacts, notes)
+
+Every message payload crosses as ROS1 bytes with its type name (`Envelope`), so the wire format
+of a message is defined once, in sandbox.msgs.
+"""
+
+from __future__ import annotations
+
+import os
+import struct
+from enum import StrEnum
+
+import msgspec
+
+MAX_FRAME_BYTES = 64 * 1024 * 1024  # [bytes] artifacts travel in frames; caps keep them below
+_LENGTH = struct.Struct("<I")
+
+
+class Clock(StrEnum):
+    """LOCKSTEP: virtual time, the node's clock functions follow simulated time.
+    REALTIME: the wall clock."""
+
+    LOCKSTEP = "lockstep"
+    REALTIME = "realtime"
+
+
+class Api(StrEnum):
+    AUTO = "auto"  # a file defining step() uses the step API, anything else runs as a script
+    STEP = "step"
+    ROSPY = "rospy"
+
+
+class Outcome(StrEnum):
+    FINISHED = "finished"  # the script returned, or signal_shutdown() was called
+    SHUTDOWN = "shutdown"  # the parent asked it to stop
+    ERROR = "error"  # the student's code raised
+
+
+class TopicDecl(msgspec.Struct, frozen=True):
+    """A topic and its ROS type name, e.g. ("Distance", "std_msgs/Int32")."""
+
+    name: str
+    type: str
+
+
+class RobotTopic(msgspec.Struct, frozen=True):
+    """One of the robot's topics: direction is "publish" (a sensor) or "subscribe" (a command)."""
+
+    name: str
+    type: str
+    direction: str
+    rate_hz: float | None = None
+
+
+class NodeInfo(msgspec.Struct, frozen=True):
+    """What a node is told about its run when its code is loaded."""
+
+    node_name: str
+    robot: str
+    robot_topics: list[RobotTopic]
+    velocity_topic: str | None
+    clock: Clock
+    start_time_s: float = 0.0
+    default_rate_hz: float = 10.0
+    params: dict[str, object] = {}
+    # A run of several nodes may make new topics between them; a single node may only use the
+    # robot's topics, so a typo in a topic name is an error rather than a silent dead topic.
+    allow_new_topics: bool = False
+
+
+class Envelope(msgspec.Struct, array_like=True, frozen=True):
+    """One ROS message on a topic: its type name and ROS1-serialized bytes."""
+
+    topic: str
+    type: str
+    data: bytes
+
+
+class Artifact(msgspec.Struct, frozen=True):
+    name: str
+    data: bytes
+
+
+class NodeError(msgspec.Struct, frozen=True):
+    """An exception in the student's code, with the traceback cut to the student's frames."""
+
+    type: str
+    message: str
+    filename: str
+    line: int | None
+    traceback: str
+
+
+# ----------------------------------------------------------------------- parent -> child
+class Load(msgspec.Struct, tag=True, frozen=True):
+    code: str
+    filename: str
+    api: Api
+    info: NodeInfo
+
+
+class Wake(msgspec.Struct, tag=True, frozen=True):
+    time_s: float
+    deliveries: list[Envelope]
+
+
+class Shutdown(msgspec.Struct, tag=True, frozen=True):
+    reason: str
+
+
+# ----------------------------------------------------------------------- child -> parent
+class Ready(msgspec.Struct, tag=True, frozen=True):
+    pid: int
+    python: str
+    startup_ms: float
+
+
+class Yield(msgspec.Struct, tag=True, frozen=True):
+    """The node sleeps until `wake_at_s` (None: until a message arrives, as in spin()) after
+    publishing `published`. `advertised`/`subscribed` list topics new since the last Yield."""
+
+    wake_at_s: float | None
+    published: list[Envelope]
+    advertised: list[TopicDecl] = []
+    subscribed: list[TopicDecl] = []
+
+
+class Exited(msgspec.Struct, tag=True, frozen=True):
+    outcome: Outcome
+    reason: str
+    error: NodeError | None = None
+    artifacts: list[Artifact] = []
+    notes: list[str] = []
+    published: list[Envelope] = []
+
+
+ToChild = Load | Wake | Shutdown
+ToParent = Ready | Yield | Exited
+
+
+class ProtocolError(RuntimeError):
+    """The other side broke the protocol (closed the pipe, sent garbage, a frame too big)."""
+
+
+class FrameWriter:
+    def __init__(self, fd: int) -> None:
+        self._fd = fd
+        self._encoder = msgspec.msgpack.Encoder()
+
+    def send(self, frame: msgspec.Struct) -> None:
+        payload = self._encoder.encode(frame)
+        data = _LENGTH.pack(len(payload)) + payload
+        view = memoryview(data)
+        while view:
+            written = os.write(self._fd, view)
+            view = view[written:]
+
+
+class FrameReader:
+    """Reads whole frames from a blocking or non-blocking pipe."""
+
+    def __init__(self, fd: int, frame_type: object) -> None:
+        self._fd = fd
+        self._decoder = msgspec.msgpack.Decoder(frame_type)
+        self._buffer = bytearray()
+
+    def fileno(self) -> int:
+        return self._fd
+
+    def pending(self) -> msgspec.Struct | None:
+        """A complete frame already buffered, or None."""
+        if len(self._buffer) < 4:
+            return None
+        (length,) = _LENGTH.unpack_from(self._buffer)
+        if length > MAX_FRAME_BYTES:
+            raise ProtocolError(f"frame of {length} bytes exceeds the {MAX_FRAME_BYTES} limit")
+        if len(self._buffer) < 4 + length:
+            return None
+        payload = bytes(self._buffer[4 : 4 + length])
+        del self._buffer[: 4 + length]
+        try:
+            return self._decoder.decode(payload)
+        except msgspec.DecodeError as error:
+            raise ProtocolError(f"undecodable frame: {error}") from None
+
+    def feed(self) -> bool:
+        """Read what the pipe has (blocking if the fd blocks); False at end of file."""
+        try:
+            chunk = os.read(self._fd, 1 << 16)
+        except BlockingIOError:
+            return True
+        if not chunk:
+            return False
+        self._buffer += chunk
+        return True
+
+    def receive(self) -> msgspec.Struct:
+        """Block until one whole frame has arrived (for blocking fds)."""
+        while True:
+            frame = self.pending()
+            if frame is not None:
+                return frame
+            if not self.feed():
+                raise ProtocolError("the other side closed the pipe")
