@@ -48,6 +48,9 @@ class Outcome(StrEnum):
     FINISHED = "finished"  # the script returned, or signal_shutdown() was called
     SHUTDOWN = "shutdown"  # the parent asked it to stop
     ERROR = "error"  # the student's code raised
+    # Set by the parent, never sent by a child:
+    KILLED = "killed"  # exceeded a budget (step time, start-up) and was killed
+    CRASHED = "crashed"  # the process died without saying why (signal, memory, broken pipe)
 
 
 class TopicDecl(msgspec.Struct, frozen=True):

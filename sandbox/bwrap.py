@@ -1,0 +1,186 @@
+"""The bubblewrap command line that walls in one node.
+
+What the node sees:
+- read-only: /usr (with the /bin, /lib, /lib64 links), the Python installation running the
+  server and the site-packages directories it imports from, /etc/fonts and /etc/ld.so.cache;
+  RoboDojo's `sandbox` package at /opt/robodojo/sandbox (and not `server`, nor the rest of the
+  checkout, nor the server's data directory: nothing else of the host file system exists);
+- writable: a private /tmp and a size-capped scratch directory /home/student (its working
+  directory), both tmpfs, gone with the process;
+- every namespace unshared (user, pid, net, ipc, uts, cgroup): no network at all, not even
+  loopback; it runs as uid/gid 65534 (nobody) with every capability dropped, in a new session,
+  with a cleared environment, and dies with its parent;
+- the stage-1 seccomp filter (sandbox/seccomp.py), read by bwrap from an inherited fd.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import site
+import subprocess
+import sys
+import sysconfig
+from pathlib import Path
+
+import sandbox
+
+SANDBOX_ROOT = "/opt/robodojo"  # where the sandbox package appears inside
+FONT_CACHE_DIR = "/opt/robodojo-fonts"  # matplotlib's font list, built once by the launcher
+SCRATCH_DIR = "/home/student"  # the node's working directory inside
+NOBODY = 65534
+TMP_BYTES = 16 * 1024 * 1024  # [bytes] private /tmp (matplotlib's cache lives in scratch)
+
+
+class SandboxUnavailable(RuntimeError):
+    """bubblewrap or user namespaces are missing; the message says how to get them."""
+
+
+def bwrap_path() -> str | None:
+    return shutil.which("bwrap")
+
+
+def _python_roots() -> list[str]:
+    """Directories the interpreter and its packages live in (deduplicated, outermost first)."""
+    candidates = {
+        sys.prefix,
+        sys.base_prefix,
+        sys.exec_prefix,
+        sysconfig.get_paths()["stdlib"],
+        sysconfig.get_paths()["platstdlib"],
+        sysconfig.get_paths()["purelib"],
+        sysconfig.get_paths()["platlib"],
+        *site.getsitepackages(),
+    }
+    real = sorted({os.path.realpath(path) for path in candidates if os.path.isdir(path)})
+    roots: list[str] = []
+    for path in real:
+        if path.startswith("/usr/"):
+            continue  # already visible through /usr
+        if not any(path == root or path.startswith(root + os.sep) for root in roots):
+            roots.append(path)
+    return roots
+
+
+def sandbox_package_dir() -> str:
+    return str(Path(sandbox.__file__).resolve().parent)
+
+
+def build_command(
+    seccomp_fd: int,
+    scratch_bytes: int,
+    runner_args: list[str],
+    font_cache: str | None = None,
+) -> list[str]:
+    """The full argv: bwrap, its options, then the Python runner and `runner_args`."""
+    bwrap = bwrap_path()
+    if bwrap is None:
+        raise SandboxUnavailable(
+            "bubblewrap (bwrap) is not installed; install the Debian package 'bubblewrap' "
+            "(apt-get install bubblewrap) or start the server with --unsafe-no-sandbox"
+        )
+    command = [
+        bwrap,
+        "--unshare-all",
+        "--unshare-user",
+        "--uid", str(NOBODY),
+        "--gid", str(NOBODY),
+        "--hostname", "robodojo-node",
+        "--cap-drop", "ALL",
+        "--die-with-parent",
+        "--new-session",
+        "--clearenv",
+        "--ro-bind", "/usr", "/usr",
+        "--symlink", "usr/bin", "/bin",
+        "--symlink", "usr/sbin", "/sbin",  # ctypes finds libseccomp through ldconfig
+        "--symlink", "usr/lib", "/lib",
+        "--symlink", "usr/lib64", "/lib64",
+        "--ro-bind-try", "/etc/fonts", "/etc/fonts",
+        "--ro-bind-try", "/etc/ld.so.cache", "/etc/ld.so.cache",
+        "--proc", "/proc",
+        "--dev", "/dev",
+        "--size", str(TMP_BYTES), "--tmpfs", "/tmp",
+        "--size", str(scratch_bytes), "--tmpfs", SCRATCH_DIR,
+        "--chdir", SCRATCH_DIR,
+    ]  # fmt: skip
+    for root in _python_roots():
+        command += ["--ro-bind", root, root]
+    command += ["--ro-bind", sandbox_package_dir(), f"{SANDBOX_ROOT}/sandbox"]
+    env = node_environment(SCRATCH_DIR)
+    if font_cache:
+        command += ["--ro-bind", font_cache, FONT_CACHE_DIR]
+        env["ROBODOJO_FONT_CACHE"] = FONT_CACHE_DIR
+    for name, value in env.items():
+        command += ["--setenv", name, value]
+    command += ["--seccomp", str(seccomp_fd)]
+    command += [sys.executable, "-I", "-c", runner_bootstrap(SANDBOX_ROOT), *runner_args]
+    return command
+
+
+def node_environment(home: str) -> dict[str, str]:
+    """The whole environment of a node (bwrap starts it with a cleared one)."""
+    return {
+        "HOME": home,
+        "MPLBACKEND": "Agg",
+        "MPLCONFIGDIR": f"{home}/.matplotlib",
+        "OPENBLAS_NUM_THREADS": "1",  # one core per node; BLAS threads would steal the other
+        "OMP_NUM_THREADS": "1",
+        "PYTHONDONTWRITEBYTECODE": "1",
+        "PYTHONHASHSEED": "0",  # set iteration order is the same in every run
+        "LANG": "C.UTF-8",
+    }
+
+
+def runner_bootstrap(root: str) -> str:
+    """The `python -I -c` program: put the sandbox package and the rospy shim on sys.path and
+    start the runner. (-I: no PYTHONPATH, no user site, no current directory on the path.)"""
+    return (
+        "import sys;"
+        f"sys.path[:0]=[{root!r},{root + '/sandbox/ros_compat'!r}];"
+        "from sandbox.runner import main;"
+        "raise SystemExit(main(sys.argv[1:]))"
+    )
+
+
+def probe() -> str | None:
+    """None when bubblewrap can build a sandbox here, else a sentence saying why not."""
+    bwrap = bwrap_path()
+    if bwrap is None:
+        return "bubblewrap (bwrap) is not installed (Debian package 'bubblewrap')"
+    try:
+        result = subprocess.run(
+            [bwrap, "--unshare-all", "--unshare-user", "--uid", str(NOBODY),
+             "--ro-bind", "/usr", "/usr", "--symlink", "usr/lib64", "/lib64",
+             "--symlink", "usr/lib", "/lib", "--symlink", "usr/bin", "/bin",
+             "--die-with-parent", "/usr/bin/true"],
+            capture_output=True, text=True, timeout=10,
+        )  # fmt: skip
+    except (OSError, subprocess.TimeoutExpired) as error:
+        return f"bubblewrap could not start: {error}"
+    if result.returncode != 0:
+        return (
+            "bubblewrap cannot create namespaces here (user namespaces disabled, or a container "
+            f"without them): {result.stderr.strip()}"
+        )
+    return None
+
+
+def prepare_font_cache(cache_root: str | None = None) -> str | None:
+    """Build matplotlib's font list once, outside any sandbox, and return its directory.
+
+    Without it every fresh sandbox scans the system fonts again (about 1 s per node start).
+    The list holds absolute font paths, which are the same inside the sandbox (/usr and the
+    Python installation are bound at their own paths). None if it cannot be built."""
+    root = cache_root or os.path.join(
+        os.environ.get("XDG_CACHE_HOME", os.path.expanduser("~/.cache")), "robodojo", "matplotlib"
+    )
+    os.makedirs(root, exist_ok=True)
+    if not any(name.startswith("fontlist") for name in os.listdir(root)):
+        subprocess.run(
+            [sys.executable, "-I", "-c", "import matplotlib.font_manager"],
+            env={**os.environ, "MPLCONFIGDIR": root, "MPLBACKEND": "Agg"},
+            capture_output=True,
+            timeout=120,
+            check=False,
+        )
+    return root if any(name.startswith("fontlist") for name in os.listdir(root)) else None

@@ -1,0 +1,395 @@
+"""The parent side of sandboxed nodes: start them, talk to them, time them, kill them.
+
+    launcher = Launcher()                      # refuses to run if bubblewrap is missing
+    node = launcher.start("follower")          # from the warm pool: imports already done
+    reply = node.load(code, "follower.py", Api.AUTO, info)   # -> Yield | Exited
+    reply = node.wake(0.1, deliveries)         # -> Yield | Exited, within the step budget
+    exited = node.shutdown("finished: duration reached")
+    launcher.close()
+
+Layers (codejail's shape): `Launcher` (policy: sandbox or refuse, the warm pool) ->
+`NodeProcess` (one child: frames, budgets, logs, kill) -> `sandbox.bwrap` (the walls) and
+`sandbox.seccomp` (the filters). Limits come from `sandbox.limits`.
+
+A node that does not yield within its budget is killed, and the reply says so; a child that
+dies (a signal, a broken pipe) turns into an `Exited` with outcome CRASHED. Nothing a node does
+raises in the caller except misuse of this API.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import logging
+import os
+import select
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from collections import deque
+from dataclasses import asdict
+from enum import StrEnum
+
+from sandbox import bwrap
+from sandbox.limits import DEFAULT_LIMITS, Limits
+from sandbox.logstream import LogStream
+from sandbox.protocol import (
+    Api,
+    Envelope,
+    Exited,
+    FrameReader,
+    FrameWriter,
+    Load,
+    NodeInfo,
+    Outcome,
+    ProtocolError,
+    Ready,
+    Shutdown,
+    ToParent,
+    Wake,
+    Yield,
+)
+from sandbox.seccomp import write_stage1_bpf
+
+log = logging.getLogger("robodojo.sandbox")
+
+DANGER = (
+    "DANGER: running student code WITHOUT a sandbox (--unsafe-no-sandbox): it can read and "
+    "write every file this server can, reach the network and kill processes"
+)
+
+
+class NodeState(StrEnum):
+    STARTING = "starting"  # spawned, imports running
+    IDLE = "idle"  # Ready received, waiting in the pool for code
+    RUNNING = "running"  # woken (or loaded), computing until it yields
+    SLEEPING = "sleeping"  # yielded, waiting for the next wake
+    EXITED = "exited"
+
+
+_TRANSITIONS = {
+    NodeState.STARTING: {NodeState.IDLE, NodeState.EXITED},
+    NodeState.IDLE: {NodeState.RUNNING, NodeState.EXITED},
+    NodeState.RUNNING: {NodeState.SLEEPING, NodeState.EXITED},
+    NodeState.SLEEPING: {NodeState.RUNNING, NodeState.EXITED},
+    NodeState.EXITED: set(),
+}
+
+
+class NodeUsageError(RuntimeError):
+    """The caller used a NodeProcess out of order (a bug in the server, not in student code)."""
+
+
+class NodeProcess:
+    """One sandboxed child. Not thread-safe: one caller drives it."""
+
+    def __init__(self, limits: Limits, sandboxed: bool, font_cache: str | None = None) -> None:
+        self.limits = limits
+        self.sandboxed = sandboxed
+        self.name = "(pool)"
+        self.state = NodeState.STARTING
+        self.exited: Exited | None = None
+        self.startup_ms: float | None = None
+        self.time_s = 0.0
+        to_child_r, to_child_w = os.pipe()
+        from_child_r, from_child_w = os.pipe()
+        log_r, log_w = os.pipe()
+        # The child finds the protocol pipes by number (inherited fds keep their numbers
+        # through bwrap), so nothing has to be moved between fork and exec.
+        settings = {
+            "rlimits": _rlimits(limits),
+            "seal": sandboxed,
+            "fd_in": to_child_r,
+            "fd_out": from_child_w,
+        }
+        with tempfile.TemporaryFile() as bpf:
+            write_stage1_bpf(bpf)
+            bpf.seek(0)
+            seccomp_fd = os.dup(bpf.fileno())
+        self._unsafe_scratch: tempfile.TemporaryDirectory | None = None
+        try:
+            if sandboxed:
+                command = bwrap.build_command(
+                    seccomp_fd, limits.scratch_bytes, [json.dumps(settings)], font_cache
+                )
+                env, cwd = None, None
+            else:
+                # DANGER path: a plain child process in a throw-away directory.
+                self._unsafe_scratch = tempfile.TemporaryDirectory(prefix="robodojo-unsafe-")
+                cwd = self._unsafe_scratch.name
+                bootstrap = bwrap.runner_bootstrap(_source_root())
+                command = [sys.executable, "-I", "-c", bootstrap, json.dumps(settings)]
+                env = bwrap.node_environment(cwd)
+                if font_cache:
+                    env["ROBODOJO_FONT_CACHE"] = font_cache
+            self.process = subprocess.Popen(
+                command,
+                stdin=subprocess.DEVNULL,
+                stdout=log_w,
+                stderr=log_w,
+                pass_fds=(to_child_r, from_child_w, seccomp_fd),
+                env=env,
+                cwd=cwd,
+            )
+        finally:
+            for fd in (to_child_r, from_child_w, log_w, seccomp_fd):
+                os.close(fd)
+        os.set_blocking(from_child_r, False)
+        os.set_blocking(log_r, False)
+        self._writer = FrameWriter(to_child_w)
+        self._reader = FrameReader(from_child_r, ToParent)
+        self._fds = (to_child_w, from_child_r, log_r)
+        self.logs = LogStream(log_r, limits.log_total_bytes, limits.log_line_bytes)
+
+    # ----------------------------------------------------------------------------- state
+    def _move(self, new: NodeState) -> None:
+        if new not in _TRANSITIONS[self.state]:
+            raise NodeUsageError(f"node {self.name}: cannot go from {self.state} to {new}")
+        self.state = new
+
+    @property
+    def pid(self) -> int:
+        return self.process.pid
+
+    def wait_ready(self, timeout_s: float | None = None) -> bool:
+        """Wait for the child's Ready; False if it died or took longer than its budget."""
+        if self.state is NodeState.IDLE:
+            return True
+        reply = self._receive(timeout_s or self.limits.startup_budget_s, "start-up")
+        if isinstance(reply, Ready):
+            self.startup_ms = reply.startup_ms
+            self._move(NodeState.IDLE)
+            return True
+        return False
+
+    # ----------------------------------------------------------------------------- driving
+    def load(self, code: str, filename: str, api: Api, info: NodeInfo) -> Yield | Exited:
+        """Give the idle node its code; returns its first Yield (setup done) or its end."""
+        if not self.wait_ready():
+            return self._end_reply()
+        self.name = info.node_name
+        self.time_s = info.start_time_s
+        self._move(NodeState.RUNNING)
+        self._send(Load(code=code, filename=filename, api=api, info=info))
+        return self._await_yield(self.limits.first_step_budget_s, "first step")
+
+    def wake(self, time_s: float, deliveries: list[Envelope]) -> Yield | Exited:
+        """Wake the sleeping node at simulated (or wall) time `time_s` with new messages."""
+        self.time_s = time_s
+        self._move(NodeState.RUNNING)
+        self._send(Wake(time_s=time_s, deliveries=deliveries))
+        return self._await_yield(self.limits.step_budget_s, "step")
+
+    def shutdown(self, reason: str) -> Exited:
+        """Ask the node to stop (on_shutdown hooks run, artifacts are collected)."""
+        if self.state is NodeState.EXITED:
+            return self.exited
+        if self.state is not NodeState.SLEEPING:
+            return self.kill(f"stopped: {reason}", Outcome.SHUTDOWN)
+        self._move(NodeState.RUNNING)
+        self._send(Shutdown(reason=reason))
+        reply = self._await_yield(self.limits.shutdown_budget_s, "shutdown")
+        while isinstance(reply, Yield):  # it slept again: it may not, the run is over
+            reply = self.kill(
+                f"stopped: {reason} (it kept running after shutdown)", Outcome.SHUTDOWN
+            )
+        return reply
+
+    def kill(self, reason: str, outcome: Outcome = Outcome.KILLED) -> Exited:
+        """End the child now (SIGKILL to bubblewrap takes the whole sandbox with it)."""
+        if self.state is not NodeState.EXITED:
+            self._finish(Exited(outcome=outcome, reason=reason))
+        return self.exited
+
+    def close(self) -> None:
+        """Release the process and its pipes (kills it if still alive)."""
+        if self.state is not NodeState.EXITED:
+            self.kill("closed")
+        for fd in self._fds:
+            with contextlib.suppress(OSError):
+                os.close(fd)
+        self._fds = ()
+        if self._unsafe_scratch is not None:
+            self._unsafe_scratch.cleanup()
+
+    # ----------------------------------------------------------------------------- internals
+    def _send(self, frame: object) -> None:
+        # A dead child makes the write fail; the next receive reports how it ended.
+        with contextlib.suppress(OSError):
+            self._writer.send(frame)
+
+    def _await_yield(self, budget_s: float, what: str) -> Yield | Exited:
+        reply = self._receive(budget_s, what)
+        if isinstance(reply, Yield):
+            self._move(NodeState.SLEEPING)
+            return reply
+        if isinstance(reply, Exited):
+            self._finish(reply)
+            return reply
+        return self._end_reply()
+
+    def _receive(self, budget_s: float, what: str) -> object | None:
+        """The next frame, or None after killing/recording a dead or overdue child."""
+        deadline = time.monotonic() + budget_s
+        poller = select.poll()
+        proto_fd, log_fd = self._fds[1], self._fds[2]
+        poller.register(proto_fd, select.POLLIN)
+        poller.register(log_fd, select.POLLIN)
+        proto_open = log_open = True
+        while True:
+            try:
+                frame = self._reader.pending()
+            except ProtocolError as error:
+                self.kill(f"node {self.name} broke the protocol: {error}", Outcome.CRASHED)
+                return None
+            if frame is not None:
+                return frame
+            remaining = deadline - time.monotonic()
+            if remaining <= 0:
+                self.kill(
+                    f"node {self.name} exceeded its {budget_s:g} s {what} budget at "
+                    f"t={self.time_s:.3f} s"
+                )
+                return None
+            events = poller.poll(remaining * 1000.0)
+            for fd, _event in events:
+                if fd == log_fd:
+                    if not self.logs.drain():
+                        poller.unregister(log_fd)
+                        log_open = False
+                elif fd == proto_fd and not self._reader.feed():
+                    poller.unregister(proto_fd)
+                    proto_open = False
+            if not proto_open and self._reader.pending() is None:
+                if log_open:
+                    self.logs.drain()
+                self._finish(Exited(outcome=Outcome.CRASHED, reason=self._death_reason()))
+                return None
+
+    def _death_reason(self) -> str:
+        try:
+            code = self.process.wait(timeout=2.0)
+        except subprocess.TimeoutExpired:
+            self.process.kill()
+            code = self.process.wait()
+        if code < 0:
+            return f"node {self.name} was killed by signal {-code} at t={self.time_s:.3f} s"
+        return f"node {self.name} died unexpectedly (exit code {code}) at t={self.time_s:.3f} s"
+
+    def _end_reply(self) -> Exited:
+        if self.exited is None:
+            self._finish(Exited(outcome=Outcome.CRASHED, reason=f"node {self.name} ended"))
+        return self.exited
+
+    def _finish(self, exited: Exited) -> None:
+        self.exited = exited
+        self.state = NodeState.EXITED
+        if self.process.poll() is None:
+            self.process.kill()
+        try:
+            self.process.wait(timeout=5.0)
+        except subprocess.TimeoutExpired:
+            log.error("node %s (pid %s) did not die after SIGKILL", self.name, self.pid)
+        if self._fds:
+            self.logs.drain()
+
+
+def _rlimits(limits: Limits) -> dict[str, int]:
+    fields = asdict(limits)
+    return {
+        key: fields[key]
+        for key in ("address_space_bytes", "cpu_seconds", "open_files", "file_size_bytes")
+    }
+
+
+def _source_root() -> str:
+    return os.path.dirname(bwrap.sandbox_package_dir())
+
+
+class Launcher:
+    """Starts sandboxed nodes, keeping `pool_size` warm ones ready.
+
+    With `unsafe_no_sandbox=False` (the default) it refuses to run where bubblewrap cannot
+    build a sandbox; with True it runs plain child processes and logs a DANGER line every time.
+    """
+
+    def __init__(
+        self,
+        limits: Limits = DEFAULT_LIMITS,
+        pool_size: int = 2,
+        unsafe_no_sandbox: bool = False,
+    ) -> None:
+        self.limits = limits
+        self.pool_size = pool_size
+        problem = bwrap.probe()
+        if problem and not unsafe_no_sandbox:
+            raise bwrap.SandboxUnavailable(
+                f"cannot run student code safely: {problem}. Install bubblewrap (apt-get install "
+                "bubblewrap) on a kernel with user namespaces, or, on a trusted machine only, "
+                "start with --unsafe-no-sandbox."
+            )
+        self.sandboxed = not unsafe_no_sandbox
+        self.font_cache = bwrap.prepare_font_cache()
+        self._pool: deque[NodeProcess] = deque()
+        self._lock = threading.Lock()
+        self._closed = False
+        self._refill_wanted = threading.Event()
+        self._refiller = threading.Thread(
+            target=self._refill_loop, name="sandbox-pool", daemon=True
+        )
+        if pool_size > 0:
+            self._refiller.start()
+            self._refill_wanted.set()
+
+    def _spawn(self) -> NodeProcess:
+        return NodeProcess(self.limits, self.sandboxed, self.font_cache)
+
+    def _refill_loop(self) -> None:
+        while not self._closed:
+            self._refill_wanted.wait()
+            self._refill_wanted.clear()
+            while not self._closed:
+                with self._lock:
+                    if len(self._pool) >= self.pool_size:
+                        break
+                node = self._spawn()
+                node.wait_ready()
+                with self._lock:
+                    if self._closed:
+                        node.close()
+                        return
+                    if node.state is NodeState.IDLE:
+                        self._pool.append(node)
+                    else:
+                        node.close()
+                        log.error("a warm sandbox process failed to start: %s", node.exited)
+                        time.sleep(1.0)  # do not spin if the machine cannot start them
+
+    def start(self, name: str) -> NodeProcess:
+        """A node ready for `load()`: a warm one if the pool has one, else a fresh one."""
+        if self._closed:
+            raise NodeUsageError("the launcher is closed")
+        if not self.sandboxed:
+            log.warning("%s (node %s)", DANGER, name)
+        node = None
+        with self._lock:
+            while self._pool:
+                candidate = self._pool.popleft()
+                if candidate.process.poll() is None:
+                    node = candidate
+                    break
+                candidate.close()
+        self._refill_wanted.set()
+        if node is None:
+            node = self._spawn()
+        node.name = name
+        return node
+
+    def close(self) -> None:
+        self._closed = True
+        self._refill_wanted.set()
+        with self._lock:
+            while self._pool:
+                self._pool.popleft().close()

@@ -1,0 +1,58 @@
+"""Shared fixtures for the sandbox tests: one real launcher (bubblewrap + seccomp) per module.
+
+The sandbox is the thing under test, so these tests never fall back to running code unsandboxed:
+without bubblewrap they fail and say how to install it (scripts/test installs it)."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import pytest
+
+from sandbox import bwrap
+from sandbox.launcher import Launcher
+from sandbox.limits import DEFAULT_LIMITS
+from sandbox.protocol import Api, Clock, Exited, NodeInfo, RobotTopic, Yield
+
+# Short budgets so the attack tests that must be killed do not take long.
+TEST_LIMITS = dataclasses.replace(
+    DEFAULT_LIMITS, step_budget_s=1.0, first_step_budget_s=4.0, shutdown_budget_s=3.0
+)
+
+CROWBOT_TOPICS = [
+    RobotTopic("Distance", "std_msgs/Int32", "publish", 20.0),
+    RobotTopic("Button", "std_msgs/Bool", "publish", 20.0),
+    RobotTopic("Light", "std_msgs/Int32MultiArray", "publish", 20.0),
+    RobotTopic("Line", "std_msgs/Int32MultiArray", "publish", 20.0),
+    RobotTopic("Control", "geometry_msgs/Twist", "subscribe"),
+    RobotTopic("Leds", "std_msgs/Int32MultiArray", "subscribe"),
+    RobotTopic("Buzzer", "std_msgs/Bool", "subscribe"),
+]
+
+
+def crowbot_info(name: str = "node", clock: Clock = Clock.LOCKSTEP) -> NodeInfo:
+    return NodeInfo(
+        node_name=name,
+        robot="crowbot",
+        robot_topics=CROWBOT_TOPICS,
+        velocity_topic="Control",
+        clock=clock,
+    )
+
+
+@pytest.fixture(scope="module")
+def launcher():
+    problem = bwrap.probe()
+    if problem:
+        pytest.fail(f"the sandbox tests need bubblewrap: {problem} (./scripts/test installs it)")
+    launcher = Launcher(limits=TEST_LIMITS, pool_size=2)
+    yield launcher
+    launcher.close()
+
+
+def run_script(launcher: Launcher, code: str, name: str = "attack", api: Api = Api.AUTO):
+    """Load `code` as a node and return (first reply, node). The caller closes the node."""
+    node = launcher.start(name)
+    reply = node.load(code, f"{name}.py", api, crowbot_info(name))
+    assert isinstance(reply, (Yield, Exited))
+    return reply, node
