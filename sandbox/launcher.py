@@ -33,6 +33,7 @@ from dataclasses import asdict
 from enum import StrEnum
 
 from sandbox import bwrap
+from sandbox.cgroups import Cgroups, NodeCgroup, enter_and_exec
 from sandbox.limits import DEFAULT_LIMITS, Limits
 from sandbox.logstream import LogStream
 from sandbox.protocol import (
@@ -85,7 +86,13 @@ class NodeUsageError(RuntimeError):
 class NodeProcess:
     """One sandboxed child. Not thread-safe: one caller drives it."""
 
-    def __init__(self, limits: Limits, sandboxed: bool, font_cache: str | None = None) -> None:
+    def __init__(
+        self,
+        limits: Limits,
+        sandboxed: bool,
+        font_cache: str | None = None,
+        cgroups: Cgroups | None = None,
+    ) -> None:
         self.limits = limits
         self.sandboxed = sandboxed
         self.name = "(pool)"
@@ -109,12 +116,16 @@ class NodeProcess:
             bpf.seek(0)
             seccomp_fd = os.dup(bpf.fileno())
         self._unsafe_scratch: tempfile.TemporaryDirectory | None = None
+        self.cgroup: NodeCgroup | None = None
         try:
             if sandboxed:
                 command = bwrap.build_command(
                     seccomp_fd, limits.scratch_bytes, [json.dumps(settings)], font_cache
                 )
                 env, cwd = None, None
+                if cgroups is not None:
+                    self.cgroup = cgroups.create(limits.memory_bytes, limits.max_pids)
+                    command = enter_and_exec(self.cgroup, command)
             else:
                 # DANGER path: a plain child process in a throw-away directory.
                 self._unsafe_scratch = tempfile.TemporaryDirectory(prefix="robodojo-unsafe-")
@@ -213,6 +224,8 @@ class NodeProcess:
         self._fds = ()
         if self._unsafe_scratch is not None:
             self._unsafe_scratch.cleanup()
+        if self.cgroup is not None:
+            self.cgroup.remove()
 
     # ----------------------------------------------------------------------------- internals
     def _send(self, frame: object) -> None:
@@ -274,6 +287,11 @@ class NodeProcess:
         except subprocess.TimeoutExpired:
             self.process.kill()
             code = self.process.wait()
+        if self.cgroup is not None and self.cgroup.oom_killed():
+            return (
+                f"node {self.name} ran out of memory (its cap is "
+                f"{self.limits.memory_bytes // (1024 * 1024)} MiB) at t={self.time_s:.3f} s"
+            )
         if code < 0:
             return f"node {self.name} was killed by signal {-code} at t={self.time_s:.3f} s"
         return f"node {self.name} died unexpectedly (exit code {code}) at t={self.time_s:.3f} s"
@@ -332,6 +350,9 @@ class Launcher:
             )
         self.sandboxed = not unsafe_no_sandbox
         self.font_cache = bwrap.prepare_font_cache()
+        self.cgroups = Cgroups.detect() if self.sandboxed else None
+        if self.sandboxed and self.cgroups is None:
+            log.info("no writable cgroup v1 memory/pids hierarchy: nodes run with rlimits only")
         self._pool: deque[NodeProcess] = deque()
         self._lock = threading.Lock()
         self._closed = False
@@ -344,7 +365,7 @@ class Launcher:
             self._refill_wanted.set()
 
     def _spawn(self) -> NodeProcess:
-        return NodeProcess(self.limits, self.sandboxed, self.font_cache)
+        return NodeProcess(self.limits, self.sandboxed, self.font_cache, self.cgroups)
 
     def _refill_loop(self) -> None:
         while not self._closed:

@@ -18,6 +18,11 @@ class Limits:
     # untouched library mappings); 1.5 GiB leaves room for real arrays but stops a memory bomb
     # long before it hurts the server or another run.
     address_space_bytes: int = 1536 * MiB
+    # Memory the node may really use (resident pages, its tmpfs files included), enforced by a
+    # memory cgroup where the machine has one; the rlimit above cannot see tmpfs or page cache.
+    memory_bytes: int = 768 * MiB
+    # Threads and processes together (pids cgroup): the interpreter and BLAS need a handful.
+    max_pids: int = 32
     # CPU seconds for the node's whole life: a run of several minutes at a few percent CPU fits
     # easily; a spinning node is killed by the step budget long before this.
     cpu_seconds: int = 900

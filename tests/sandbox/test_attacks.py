@@ -311,3 +311,16 @@ def test_broken_code_comes_back_readable(launcher, code, error_type, line):
     assert exited.error.line == line
     assert "attack.py" in exited.error.traceback
     assert "/opt/robodojo" not in exited.error.traceback
+
+
+def test_touched_memory_is_capped_by_the_cgroup_or_the_rlimit(launcher):
+    code = (
+        "import numpy as np\nhog = []\nfor _ in range(100):\n    hog.append(np.ones(20_000_000))\n"
+    )
+    with Bystander(launcher):
+        exited = finish(launcher, code)
+    if launcher.cgroups is not None:
+        assert exited.outcome is Outcome.CRASHED
+        assert "ran out of memory (its cap is 768 MiB)" in exited.reason
+    else:
+        assert exited.outcome is Outcome.ERROR and exited.error.type == "MemoryError"

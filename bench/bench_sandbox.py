@@ -1,0 +1,141 @@
+"""Sandboxed node speed: start time, step round trip, and the Jupyter path as the reference.
+
+Prints median and p99 for
+- cold start: spawn bubblewrap + Python + numpy/matplotlib/scikit-fuzzy until Ready;
+- warm start: take a ready node from the launcher's pool and load a controller;
+- step round trip: parent Wake -> trivial step-API controller -> Yield back (the per-period cost
+  of running student code), several thousand times;
+- the same round trip through a Jupyter kernel execute request (jupyter_client + ipykernel),
+  the path 003_4f92d1fa0a49ddae.txt section 5.9 drove its Stanley controller through and found
+  limited to 5 Hz; the ratio says how much faster the sandbox is.
+
+jupyter_client and ipykernel are not RoboDojo dependencies; the script installs them with pip
+when missing (or skips the reference with --no-jupyter).
+
+Usage: python bench/bench_sandbox.py [--steps 5000] [--starts 8] [--no-jupyter]
+Targets (issue 3): round trip p50 < 50 us and p99 < 300 us, >= 50x faster than Jupyter.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import statistics
+import subprocess
+import sys
+import time
+
+from sandbox.launcher import Launcher
+from sandbox.protocol import Api, Clock, Envelope, NodeInfo, RobotTopic, Yield
+
+INFO = NodeInfo(
+    node_name="bench",
+    robot="crowbot",
+    robot_topics=[
+        RobotTopic("Distance", "std_msgs/Int32", "publish", 20.0),
+        RobotTopic("Control", "geometry_msgs/Twist", "subscribe"),
+    ],
+    velocity_topic="Control",
+    clock=Clock.LOCKSTEP,
+)
+CONTROLLER = "def step(obs):\n    return (0.1, 0.0)\n"
+DISTANCE_50_CM = b"\x32\x00\x00\x00"  # std_msgs/Int32(50), ROS1 bytes
+
+
+def stats(label: str, seconds: list[float], unit: float = 1e6, name: str = "us") -> float:
+    ordered = sorted(seconds)
+    p50 = statistics.median(ordered) * unit
+    p99 = ordered[min(len(ordered) - 1, round(0.99 * (len(ordered) - 1)))] * unit
+    print(f"{label:<44} p50 {p50:10.1f} {name}   p99 {p99:10.1f} {name}   (n={len(ordered)})")
+    return p50
+
+
+def bench_starts(count: int) -> None:
+    cold = Launcher(pool_size=0)
+    times = []
+    for _ in range(count):
+        start = time.perf_counter()
+        node = cold.start("cold")
+        node.wait_ready()
+        times.append(time.perf_counter() - start)
+        node.close()
+    cold.close()
+    stats("cold start (spawn until Ready)", times, 1e3, "ms")
+
+    warm = Launcher(pool_size=2)
+    times = []
+    for _ in range(count):
+        while len(warm._pool) < 1:  # let the pool refill: we measure the warm path
+            time.sleep(0.05)
+        start = time.perf_counter()
+        node = warm.start("warm")
+        reply = node.load(CONTROLLER, "bench.py", Api.STEP, INFO)
+        times.append(time.perf_counter() - start)
+        assert isinstance(reply, Yield), reply
+        node.close()
+    warm.close()
+    stats("warm start (pool -> controller loaded)", times, 1e3, "ms")
+
+
+def bench_round_trip(steps: int) -> float:
+    launcher = Launcher(pool_size=1)
+    node = launcher.start("bench")
+    reply = node.load(CONTROLLER, "bench.py", Api.STEP, INFO)
+    assert isinstance(reply, Yield), reply
+    delivery = [Envelope("Distance", "std_msgs/Int32", DISTANCE_50_CM)]
+    times = []
+    for k in range(1, steps + 1):
+        start = time.perf_counter()
+        reply = node.wake(k * 0.1, delivery)
+        times.append(time.perf_counter() - start)
+    assert isinstance(reply, Yield) and reply.published, reply
+    node.close()
+    launcher.close()
+    return stats("sandbox step round trip (Wake -> Yield)", times)
+
+
+def bench_jupyter(steps: int) -> float | None:
+    if (
+        importlib.util.find_spec("jupyter_client") is None
+        or importlib.util.find_spec("ipykernel") is None
+    ):
+        print("installing jupyter_client and ipykernel for the reference measurement ...")
+        subprocess.run(
+            [sys.executable, "-m", "pip", "install", "-q", "jupyter_client", "ipykernel"],
+            check=True,
+        )
+    from jupyter_client.manager import start_new_kernel
+
+    manager, client = start_new_kernel(kernel_name="python3")
+    try:
+        client.execute_interactive("def step(obs):\n    return (0.1, 0.0)\n", timeout=30)
+        times = []
+        for k in range(steps):
+            start = time.perf_counter()
+            reply = client.execute_interactive(
+                f"step({{'Distance': 50, 't': {k * 0.1}}})", timeout=30
+            )
+            times.append(time.perf_counter() - start)
+            assert reply["content"]["status"] == "ok"
+        return stats("Jupyter execute request (reference)", times)
+    finally:
+        client.stop_channels()
+        manager.shutdown_kernel(now=True)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--steps", type=int, default=5000)
+    parser.add_argument("--starts", type=int, default=8)
+    parser.add_argument("--no-jupyter", action="store_true")
+    args = parser.parse_args()
+    bench_starts(args.starts)
+    sandbox_p50 = bench_round_trip(args.steps)
+    if not args.no_jupyter:
+        jupyter_p50 = bench_jupyter(max(200, args.steps // 10))
+        if jupyter_p50:
+            print(f"ratio (Jupyter p50 / sandbox p50): {jupyter_p50 / sandbox_p50:.0f}x")
+
+
+if __name__ == "__main__":
+    main()
