@@ -17,7 +17,8 @@ inside each interval (wrap at +-pi handled by searching a copy shifted by 2 pi),
 (ray, surface) pairs are intersected, with the same arithmetic as the dense path. The nearest hit
 per ray wins; ties go to the same surface as in the dense path (segments first, then lower
 index), so the two paths agree exactly. Intervals are widened by a nano-radian, so rounding
-can only add candidates (which then miss), never drop a hit.
+can only add candidates (which then miss), never drop a hit. The crop-field scan drops from ~2.4 ms
+to ~0.35 ms (`python3 -m bench.bench_scans`).
 
 Fallback: casts with one origin per ray ((K, 2) origins), casts from inside a cylinder (range 0
 for every ray: a degenerate case where interval culling buys nothing) and small casts (a few rays
