@@ -1,0 +1,228 @@
+"""The node host: runs one student controller inside the sandboxed child, after `Load`.
+
+    exited = run_node(link, load, workdir)
+
+`run_node` compiles the code under the student's filename, picks the API (a top-level
+`def step` and no `init_node` call -> step API, else a rospy script), runs it with the node
+clock, the rospy shim and a rospy-style logging handler in place, sends a `Yield` at every
+sleep and returns the final `Exited` frame (the runner sends it). Student errors never escape:
+they become `Outcome.ERROR` with a traceback cut to the student's frames. A broken pipe to the
+parent raises the link's `ProtocolError`.
+
+What run_node sets up for itself (and undoes on return, so tests can run many nodes in one
+process): sandbox/ros_compat on sys.path, MPLBACKEND=Agg, the `time` patches of a lockstep
+clock, the working directory, sys.argv = [filename], `__main__`, warnings in their default
+(print-once) form, and a rospy-style root logging handler.
+"""
+
+from __future__ import annotations
+
+import ast
+import contextlib
+import logging
+import os
+import sys
+import types
+import warnings
+from contextlib import ExitStack
+from typing import ClassVar, Protocol
+
+from sandbox import runtime
+from sandbox.artifacts import collect_artifacts
+from sandbox.limits import DEFAULT_LIMITS, Limits
+from sandbox.protocol import Api, Clock, Exited, Load, NodeError, Outcome
+from sandbox.runtime import LinkLost, NodeFailure, NodeRuntime, ROSInterruptException
+from sandbox.step_api import StepController
+from sandbox.student_errors import StepError, from_exception, register_source, summary
+from sandbox.vclock import NodeClock, TimePatch
+
+ROS_COMPAT_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "ros_compat")
+STEP_MODULE_NAME = "controller"  # __name__ of a step-API module, so a __main__ guard stays idle
+
+
+class Link(Protocol):
+    def send(self, frame: object) -> None: ...
+
+    def receive(self) -> object: ...
+
+
+def install_ros_compat() -> None:
+    """Make `import rospy` and `from std_msgs.msg import ...` find the shim (idempotent)."""
+    if ROS_COMPAT_DIR not in sys.path:
+        sys.path.insert(0, ROS_COMPAT_DIR)
+
+
+def choose_api(tree: ast.Module, requested: Api) -> Api:
+    if requested is not Api.AUTO:
+        return requested
+    defines_step = any(
+        isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef) and node.name == "step"
+        for node in tree.body
+    )
+    calls_init_node = any(
+        isinstance(node, ast.Call)
+        and (getattr(node.func, "attr", None) or getattr(node.func, "id", None)) == "init_node"
+        for node in ast.walk(tree)
+    )
+    return Api.STEP if defines_step and not calls_init_node else Api.ROSPY
+
+
+class _LogHandler(logging.Handler):
+    """Python logging in the node prints like rospy: `[WARN] [3.200000]: name: text`."""
+
+    _LEVELS: ClassVar[dict[str, str]] = {"WARNING": "WARN", "CRITICAL": "FATAL"}
+
+    def __init__(self, node: NodeRuntime) -> None:
+        super().__init__()
+        self._node = node
+
+    def emit(self, record: logging.LogRecord) -> None:
+        level = self._LEVELS.get(record.levelname, record.levelname)
+        name = "" if record.name == "root" else f"{record.name}: "
+        try:
+            text = record.getMessage()
+        except Exception:  # a bad %-format in the student's call
+            text = f"{record.msg} {record.args}"
+        self._node.log(level, name + text)
+
+
+def _show_warning(
+    message: Warning | str,
+    category: type[Warning],
+    filename: str,
+    lineno: int,
+    file: object = None,
+    line: str | None = None,
+) -> None:
+    """Warnings from the student's code go to the log stream, as in a plain `python` run."""
+    sys.stderr.write(warnings.formatwarning(message, category, filename, lineno, line))
+
+
+def _install_logging(stack: ExitStack, node: NodeRuntime) -> None:
+    """Root logging prints rospy-style lines at INFO; the student's own basicConfig() still
+    takes over (it replaces our handler, as it would replace nothing in a plain script)."""
+    handler = _LogHandler(node)
+    root = logging.getLogger()
+    saved_level, saved_basic_config = root.level, logging.basicConfig
+
+    def basic_config(**kwargs: object) -> None:
+        if root.handlers == [handler]:
+            kwargs.setdefault("force", True)
+        saved_basic_config(**kwargs)  # type: ignore[arg-type]
+
+    root.addHandler(handler)
+    root.setLevel(logging.INFO)
+    logging.basicConfig = basic_config
+    stack.callback(root.removeHandler, handler)
+    stack.callback(root.setLevel, saved_level)
+    stack.callback(setattr, logging, "basicConfig", saved_basic_config)
+
+
+def _environment(stack: ExitStack, node: NodeRuntime, load: Load, workdir: str) -> None:
+    """Point the interpreter at this node; every change is undone when `stack` closes."""
+    install_ros_compat()
+    os.environ["MPLBACKEND"] = "Agg"
+    if "matplotlib" in sys.modules:
+        sys.modules["matplotlib"].use("Agg")
+    for stream in (sys.stdout, sys.stderr):
+        with contextlib.suppress(AttributeError, ValueError, OSError):
+            stream.reconfigure(line_buffering=True)  # type: ignore[union-attr]
+    previous_cwd = os.getcwd()
+    os.chdir(workdir)
+    stack.callback(os.chdir, previous_cwd)
+    saved_argv, saved_main = sys.argv, sys.modules.get("__main__")
+    sys.argv = [load.filename]
+    stack.callback(setattr, sys, "argv", saved_argv)
+    if saved_main is not None:
+        stack.callback(sys.modules.__setitem__, "__main__", saved_main)
+    else:
+        stack.callback(sys.modules.pop, "__main__", None)
+    stack.callback(sys.modules.pop, STEP_MODULE_NAME, None)
+    stack.enter_context(warnings.catch_warnings())
+    warnings.resetwarnings()
+    warnings.simplefilter("default")
+    warnings.showwarning = _show_warning
+    _install_logging(stack, node)
+    if load.info.clock is Clock.LOCKSTEP:
+        stack.callback(TimePatch(node.clock, node.sleep_for).remove)
+    runtime.activate(node)
+    stack.callback(runtime.activate, None)
+
+
+def _execute(node: NodeRuntime, load: Load) -> None:
+    """Compile and run the student's module (and its steps); raises what the student raised."""
+    tree = compile(load.code, load.filename, "exec", flags=ast.PyCF_ONLY_AST, dont_inherit=True)
+    code = compile(tree, load.filename, "exec", dont_inherit=True)
+    api = choose_api(tree, load.api)
+    module = types.ModuleType("__main__" if api is Api.ROSPY else STEP_MODULE_NAME)
+    module.__file__ = load.filename
+    sys.modules["__main__" if api is Api.ROSPY else STEP_MODULE_NAME] = module
+    if api is Api.STEP:
+        node.node_name = "/" + load.info.node_name.strip("/")
+        node.implicit_name = True
+        exec(code, module.__dict__)
+        if not callable(module.__dict__.get("step")):
+            raise StepError(
+                "the step API needs a function `def step(obs):` at the top level of the file",
+                None,
+            )
+        StepController(node, module.__dict__, tree).run()
+    else:
+        exec(code, module.__dict__)
+
+
+def _finish(
+    node: NodeRuntime, error: BaseException | None, load: Load
+) -> tuple[Outcome, str, NodeError | None]:
+    """The outcome, once the student's code has stopped (normally or by `error`)."""
+    failure = node.failure
+    if isinstance(error, NodeFailure):
+        failure = error.original
+    elif error is not None and not isinstance(error, ROSInterruptException | SystemExit):
+        failure = error
+    if failure is None:
+        if node.shutdown is not None and node.shutdown.by_parent:
+            outcome, reason = Outcome.SHUTDOWN, node.shutdown.reason
+        elif isinstance(error, ROSInterruptException) and node.shutdown is None:
+            outcome, reason = Outcome.SHUTDOWN, f"ROSInterruptException: {error}"
+        elif node.shutdown is not None:
+            outcome, reason = Outcome.FINISHED, f"signal_shutdown: {node.shutdown.reason}"
+        elif isinstance(error, SystemExit):
+            outcome, reason = Outcome.FINISHED, f"sys.exit({error.code!r})"
+        else:
+            outcome, reason = Outcome.FINISHED, "script ended"
+        try:
+            node.signal_shutdown(reason)  # on_shutdown hooks run at the end, as rospy's do
+        except NodeFailure as hook_error:
+            failure = hook_error.original
+        else:
+            return outcome, reason, None
+    problem = from_exception(failure, load.filename)
+    return Outcome.ERROR, summary(problem), problem
+
+
+def run_node(link: Link, load: Load, workdir: str, limits: Limits = DEFAULT_LIMITS) -> Exited:
+    """Run the student's code to its end; return the Exited frame for the runner to send."""
+    node = NodeRuntime(link, load.info, NodeClock(load.info.clock, load.info.start_time_s))
+    register_source(load.filename, load.code)
+    error: BaseException | None = None
+    with ExitStack() as stack:
+        _environment(stack, node, load, workdir)
+        try:
+            _execute(node, load)
+        except LinkLost as lost:
+            raise lost.args[0] from None
+        except BaseException as raised:  # the student's, whatever it is
+            error = raised
+        outcome, reason, problem = _finish(node, error, load)
+        sys.stdout.flush()
+        sys.stderr.flush()
+    artifacts, notes = collect_artifacts(workdir, limits)
+    return Exited(
+        outcome=outcome,
+        reason=reason,
+        error=problem,
+        artifacts=artifacts,
+        notes=notes,
+        published=node.take_outbox(),
+    )

@@ -1,0 +1,13 @@
+"""The geometry_msgs message classes (defined once, in sandbox.msgs.geometry_msgs)."""
+
+from sandbox.msgs import Message as _Message
+from sandbox.msgs import geometry_msgs as _definitions
+
+__all__ = sorted(
+    name
+    for name, value in vars(_definitions).items()
+    if isinstance(value, type)
+    and issubclass(value, _Message)
+    and getattr(value, "_type", "").startswith("geometry_msgs/")
+)
+globals().update({name: getattr(_definitions, name) for name in __all__})

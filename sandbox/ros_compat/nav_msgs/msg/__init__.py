@@ -1,0 +1,13 @@
+"""The nav_msgs message classes (defined once, in sandbox.msgs.nav_msgs)."""
+
+from sandbox.msgs import Message as _Message
+from sandbox.msgs import nav_msgs as _definitions
+
+__all__ = sorted(
+    name
+    for name, value in vars(_definitions).items()
+    if isinstance(value, type)
+    and issubclass(value, _Message)
+    and getattr(value, "_type", "").startswith("nav_msgs/")
+)
+globals().update({name: getattr(_definitions, name) for name in __all__})

@@ -1,0 +1,1 @@
+"""`sensor_msgs` for student code: `from sensor_msgs.msg import ...` (see sandbox.msgs)."""

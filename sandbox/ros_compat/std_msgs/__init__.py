@@ -1,0 +1,1 @@
+"""`std_msgs` for student code: `from std_msgs.msg import ...` (see sandbox.msgs)."""

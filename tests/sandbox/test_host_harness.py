@@ -1,0 +1,198 @@
+"""A parent stand-in for sandbox.host.run_node, and the tests of that stand-in itself.
+
+`Parent` runs run_node in a thread over a Link of two queues. Every frame crosses as msgpack
+bytes through the protocol's own Struct types, so a frame that could not go over the real pipe
+fails here too.
+"""
+
+from __future__ import annotations
+
+import queue
+import textwrap
+import threading
+from collections.abc import Callable, Iterable
+from pathlib import Path
+
+import msgspec
+
+from sandbox.host import run_node
+from sandbox.limits import DEFAULT_LIMITS, Limits
+from sandbox.msgs import Message
+from sandbox.protocol import (
+    Api,
+    Clock,
+    Envelope,
+    Exited,
+    Load,
+    NodeInfo,
+    Outcome,
+    ProtocolError,
+    RobotTopic,
+    Shutdown,
+    ToChild,
+    ToParent,
+    Wake,
+    Yield,
+)
+
+TIMEOUT_S = 20.0  # [s] generous wall-clock bound on any single frame, so a bug fails, not hangs
+
+CROWBOT_TOPICS = [
+    RobotTopic("Distance", "std_msgs/Int32", "publish", 20.0),
+    RobotTopic("Button", "std_msgs/Bool", "publish", 20.0),
+    RobotTopic("Light", "std_msgs/Int32MultiArray", "publish", 20.0),
+    RobotTopic("Line", "std_msgs/Int32MultiArray", "publish", 20.0),
+    RobotTopic("Control", "geometry_msgs/Twist", "subscribe"),
+    RobotTopic("Leds", "std_msgs/Int32MultiArray", "subscribe"),
+    RobotTopic("Buzzer", "std_msgs/Bool", "subscribe"),
+]
+
+
+def crowbot_info(**overrides: object) -> NodeInfo:
+    fields: dict[str, object] = {
+        "node_name": "student",
+        "robot": "crowbot",
+        "robot_topics": CROWBOT_TOPICS,
+        "velocity_topic": "Control",
+        "clock": Clock.LOCKSTEP,
+    }
+    fields.update(overrides)
+    return NodeInfo(**fields)  # type: ignore[arg-type]
+
+
+def envelope(topic: str, message: Message) -> Envelope:
+    return Envelope(topic, message._type, message.serialize())
+
+
+class QueueLink:
+    """The child's end of the pipes: msgpack frames through two queues."""
+
+    def __init__(self) -> None:
+        self.to_parent: queue.Queue[bytes] = queue.Queue()
+        self.to_child: queue.Queue[bytes] = queue.Queue()
+        self._encoder = msgspec.msgpack.Encoder()
+        self._decoder = msgspec.msgpack.Decoder(ToChild)
+
+    def send(self, frame: object) -> None:
+        self.to_parent.put(self._encoder.encode(frame))
+
+    def receive(self) -> object:
+        try:
+            data = self.to_child.get(timeout=TIMEOUT_S)
+        except queue.Empty:
+            raise ProtocolError("test parent sent nothing") from None
+        if data == b"":
+            raise ProtocolError("the other side closed the pipe")
+        return self._decoder.decode(data)
+
+
+class Parent:
+    """Loads code into run_node (in a thread) and speaks the protocol to it."""
+
+    def __init__(
+        self,
+        code: str,
+        workdir: Path,
+        *,
+        info: NodeInfo | None = None,
+        api: Api = Api.AUTO,
+        filename: str = "node.py",
+        limits: Limits = DEFAULT_LIMITS,
+    ) -> None:
+        self.link = QueueLink()
+        self._decoder = msgspec.msgpack.Decoder(ToParent)
+        self._encoder = msgspec.msgpack.Encoder()
+        self.crash: BaseException | None = None
+        load = Load(textwrap.dedent(code), filename, api, info or crowbot_info())
+
+        def child() -> None:
+            try:
+                exited = run_node(self.link, load, str(workdir), limits)
+                self.link.send(exited)
+            except BaseException as error:  # surfaced to the test by next()
+                self.crash = error
+                self.link.to_parent.put(b"")
+
+        self._thread = threading.Thread(target=child, daemon=True)
+        self._thread.start()
+
+    def next(self) -> Yield | Exited:
+        data = self.link.to_parent.get(timeout=TIMEOUT_S)
+        if data == b"":
+            assert self.crash is not None
+            raise self.crash
+        frame = self._decoder.decode(data)
+        assert isinstance(frame, Yield | Exited), frame
+        if isinstance(frame, Exited):
+            self._thread.join(TIMEOUT_S)
+        return frame
+
+    def wake(self, time_s: float, deliveries: Iterable[Envelope] = ()) -> Yield | Exited:
+        self.link.to_child.put(self._encoder.encode(Wake(time_s, list(deliveries))))
+        return self.next()
+
+    def shutdown(self, reason: str = "stop pressed") -> Exited:
+        self.link.to_child.put(self._encoder.encode(Shutdown(reason)))
+        frame = self.next()
+        assert isinstance(frame, Exited), frame
+        return frame
+
+    def run_lockstep(
+        self,
+        sensors: Callable[[float], list[Envelope]] = lambda t: [],
+        *,
+        max_wakes: int = 1000,
+        spin_period_s: float = 0.05,
+    ) -> tuple[list[Yield], Exited]:
+        """Wake the node at each time it asks for (spin: every `spin_period_s`) until it exits."""
+        yields: list[Yield] = []
+        frame = self.next()
+        now = 0.0
+        while isinstance(frame, Yield):
+            yields.append(frame)
+            assert len(yields) <= max_wakes, "the node kept sleeping"
+            now = frame.wake_at_s if frame.wake_at_s is not None else now + spin_period_s
+            frame = self.wake(now, sensors(now))
+        return yields, frame
+
+
+def run(code: str, workdir: Path, **kwargs: object) -> tuple[list[Yield], Exited]:
+    return Parent(code, workdir, **kwargs).run_lockstep()  # type: ignore[arg-type]
+
+
+def test_a_script_that_never_sleeps_exits_with_what_it_published(tmp_path: Path) -> None:
+    yields, exited = run(
+        """
+        import rospy
+        from std_msgs.msg import Bool
+        rospy.init_node("beeper")
+        rospy.Publisher("Buzzer", Bool, queue_size=1).publish(True)
+        """,
+        tmp_path,
+    )
+    assert yields == []
+    assert exited.outcome is Outcome.FINISHED and exited.reason == "script ended"
+    assert [(e.topic, e.type) for e in exited.published] == [("Buzzer", "std_msgs/Bool")]
+
+
+def test_a_broken_pipe_reaches_the_runner_as_protocol_error(tmp_path: Path) -> None:
+    parent = Parent(
+        """
+        import rospy
+        rospy.init_node("sleeper")
+        while True:
+            try:
+                rospy.sleep(0.1)
+            except Exception:
+                pass  # a student's catch-all must not swallow a lost parent
+        """,
+        tmp_path,
+    )
+    assert isinstance(parent.next(), Yield)
+    parent.link.to_child.put(b"")
+    try:
+        parent.next()
+    except ProtocolError as error:
+        assert "closed" in str(error)
+    else:
+        raise AssertionError("run_node should have raised ProtocolError")
