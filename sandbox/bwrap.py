@@ -112,6 +112,8 @@ def build_command(
         env["ROBODOJO_FONT_CACHE"] = FONT_CACHE_DIR
     for name, value in env.items():
         command += ["--setenv", name, value]
+    # The root itself is a tmpfs bwrap made; without this a node could fill memory writing to /.
+    command += ["--remount-ro", "/"]
     command += ["--seccomp", str(seccomp_fd)]
     command += [sys.executable, "-I", "-c", runner_bootstrap(SANDBOX_ROOT), *runner_args]
     return command

@@ -23,6 +23,7 @@ import json
 import logging
 import os
 import select
+import signal
 import subprocess
 import sys
 import tempfile
@@ -292,8 +293,14 @@ class NodeProcess:
                 f"node {self.name} ran out of memory (its cap is "
                 f"{self.limits.memory_bytes // (1024 * 1024)} MiB) at t={self.time_s:.3f} s"
             )
-        if code < 0:
-            return f"node {self.name} was killed by signal {-code} at t={self.time_s:.3f} s"
+        # bwrap (and the cgroup shell before it) exits with 128 + N when the node died of
+        # signal N; a plain child shows it as -N.
+        signal_number = -code if code < 0 else code - 128 if code > 128 else None
+        if signal_number:
+            return (
+                f"node {self.name} was killed by signal {signal_number} "
+                f"({_signal_name(signal_number)}) at t={self.time_s:.3f} s"
+            )
         return f"node {self.name} died unexpectedly (exit code {code}) at t={self.time_s:.3f} s"
 
     def _end_reply(self) -> Exited:
@@ -312,6 +319,13 @@ class NodeProcess:
             log.error("node %s (pid %s) did not die after SIGKILL", self.name, self.pid)
         if self._fds:
             self.logs.drain()
+
+
+def _signal_name(number: int) -> str:
+    try:
+        return signal.Signals(number).name
+    except ValueError:
+        return "unknown signal"
 
 
 def _rlimits(limits: Limits) -> dict[str, int]:
