@@ -176,9 +176,10 @@ def test_server_data_and_source_are_invisible(launcher, tmp_path):
 
 
 def test_another_nodes_scratch_directory_is_private(launcher):
-    writer, writer_node = run_script(
-        launcher, "open('secret.txt', 'w').write('42')\nimport rospy\nrospy.init_node('w')\nrospy.spin()\n", "writer"
+    keeper = (
+        "open('secret.txt', 'w').write('42')\nimport rospy\nrospy.init_node('w')\nrospy.spin()\n"
     )
+    writer, writer_node = run_script(launcher, keeper, "writer")
     try:
         assert isinstance(writer, Yield)  # spinning, its scratch directory alive
         code = "import os\nprint(sorted(os.listdir('.')))\nopen('secret.txt').read()\n"
