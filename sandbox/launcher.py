@@ -154,6 +154,11 @@ class NodeProcess:
         self._reader = FrameReader(from_child_r, ToParent)
         self._fds = (to_child_w, from_child_r, log_r)
         self.logs = LogStream(log_r, limits.log_total_bytes, limits.log_line_bytes)
+        # One poller for the node's life: registering fds anew costs microseconds every step.
+        self._poller = select.poll()
+        self._poller.register(from_child_r, select.POLLIN)
+        self._poller.register(log_r, select.POLLIN)
+        self._proto_open = self._log_open = True
 
     # ----------------------------------------------------------------------------- state
     def _move(self, new: NodeState) -> None:
@@ -247,11 +252,7 @@ class NodeProcess:
     def _receive(self, budget_s: float, what: str) -> object | None:
         """The next frame, or None after killing/recording a dead or overdue child."""
         deadline = time.monotonic() + budget_s
-        poller = select.poll()
-        proto_fd, log_fd = self._fds[1], self._fds[2]
-        poller.register(proto_fd, select.POLLIN)
-        poller.register(log_fd, select.POLLIN)
-        proto_open = log_open = True
+        poller, proto_fd, log_fd = self._poller, self._fds[1], self._fds[2]
         while True:
             try:
                 frame = self._reader.pending()
@@ -272,12 +273,12 @@ class NodeProcess:
                 if fd == log_fd:
                     if not self.logs.drain():
                         poller.unregister(log_fd)
-                        log_open = False
+                        self._log_open = False
                 elif fd == proto_fd and not self._reader.feed():
                     poller.unregister(proto_fd)
-                    proto_open = False
-            if not proto_open and self._reader.pending() is None:
-                if log_open:
+                    self._proto_open = False
+            if not self._proto_open and self._reader.pending() is None:
+                if self._log_open:
                     self.logs.drain()
                 self._finish(Exited(outcome=Outcome.CRASHED, reason=self._death_reason()))
                 return None

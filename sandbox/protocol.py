@@ -167,10 +167,11 @@ class FrameWriter:
     def send(self, frame: msgspec.Struct) -> None:
         payload = self._encoder.encode(frame)
         data = _LENGTH.pack(len(payload)) + payload
-        view = memoryview(data)
-        while view:
-            written = os.write(self._fd, view)
-            view = view[written:]
+        written = os.write(self._fd, data)  # one write for any frame that fits the pipe
+        if written < len(data):
+            view = memoryview(data)[written:]
+            while view:
+                view = view[os.write(self._fd, view) :]
 
 
 class FrameReader:

@@ -104,6 +104,7 @@ class NodeRuntime:
     _types: dict[str, str] = field(default_factory=dict)  # topic -> type, robot's and new ones
     _robot: dict[str, tuple[str, str]] = field(default_factory=dict)  # name -> (type, direction)
     _advertised: set[str] = field(default_factory=set)
+    _advertise_checked: dict[tuple[str, Any], str] = field(default_factory=dict)
     _subscribed: set[str] = field(default_factory=set)
     _new_advertised: list[TopicDecl] = field(default_factory=list)
     _new_subscribed: list[TopicDecl] = field(default_factory=list)
@@ -160,6 +161,10 @@ class NodeRuntime:
 
     def advertise(self, topic: str, data_class: Any) -> str:
         """Check that this node may publish `data_class` on `topic`; return the clean name."""
+        # Hot path: the step API and many scripts publish the same topic every period.
+        checked = self._advertise_checked.get((topic, data_class))
+        if checked is not None:
+            return checked
         name = normalize_topic(topic)
         robot = self._robot.get(name)
         if robot is not None and robot[1] == "publish":
@@ -174,6 +179,8 @@ class NodeRuntime:
         if name not in self._advertised:
             self._advertised.add(name)
             self._new_advertised.append(TopicDecl(name, type_name))
+        if isinstance(topic, str):
+            self._advertise_checked[(topic, data_class)] = name
         return name
 
     def subscribe(
@@ -290,12 +297,14 @@ class NodeRuntime:
 
     def _deliver(self, deliveries: list[Envelope]) -> None:
         for envelope in deliveries:
-            topic = normalize_topic(envelope.topic)
+            topic = envelope.topic  # the parent sends clean names
             self.latest[topic] = envelope
             decoded: dict[type, Message] = {}
             for subscription in list(self._subscribers.get(topic, ())):
                 if self.shutdown is not None:
                     return
+                if subscription.callback is None:
+                    continue  # the step API reads `latest` instead
                 data_class = subscription.data_class
                 if data_class._type != envelope.type:
                     self.warn(
