@@ -1,0 +1,124 @@
+"""The launcher end to end: policy without bubblewrap, a real course script in the sandbox,
+artifacts and logs across the wall, budgets, misuse of the API."""
+
+from __future__ import annotations
+
+import logging
+
+import pytest
+
+from sandbox.bwrap import SandboxUnavailable
+from sandbox.launcher import DANGER, Launcher, NodeUsageError
+from sandbox.protocol import Api, Envelope, Exited, Outcome, Yield
+from tests.sandbox.conftest import crowbot_info, run_script
+
+COURSE_SCRIPT = """
+import time
+import rospy
+import matplotlib.pyplot as plt
+from std_msgs.msg import Int32
+from geometry_msgs.msg import Twist
+
+distance = 100
+periods = []
+
+def on_distance(msg):
+    global distance
+    distance = msg.data
+
+rospy.init_node("approach")
+rospy.Subscriber("/Distance", Int32, on_distance)
+pub = rospy.Publisher("/Control", Twist, queue_size=10)
+rate = rospy.Rate(10)
+last = time.perf_counter()
+while distance > 20 and not rospy.is_shutdown():
+    move = Twist()
+    move.linear.x = 0.1
+    pub.publish(move)
+    rate.sleep()
+    now = time.perf_counter()
+    periods.append(now - last)
+    last = now
+rospy.loginfo("stopped at %d cm", distance)
+rospy.signal_shutdown("reached the wall")
+plt.plot(periods)
+plt.savefig("periods.png")
+with open("periods.csv", "w") as f:
+    f.write("\\n".join(f"{p:.6f}" for p in periods))
+"""
+
+
+def distance(cm: int) -> Envelope:
+    return Envelope("Distance", "std_msgs/Int32", cm.to_bytes(4, "little", signed=True))
+
+
+def test_course_script_runs_unchanged_in_the_sandbox(launcher):
+    reply, node = run_script(launcher, COURSE_SCRIPT, "approach")
+    try:
+        assert isinstance(reply, Yield) and reply.wake_at_s == pytest.approx(0.1)
+        wakes = []
+        for k, cm in enumerate([60, 45, 30, 15], start=1):
+            assert [e.type for e in reply.published] == ["geometry_msgs/Twist"]
+            reply = node.wake(0.1 * k, [distance(cm)])
+            wakes.append(getattr(reply, "wake_at_s", None))
+        assert isinstance(reply, Exited), reply
+        assert reply.outcome is Outcome.FINISHED
+        assert reply.reason == "signal_shutdown: reached the wall"
+        assert wakes[:3] == pytest.approx([0.2, 0.3, 0.4])
+        artifacts = {a.name: a.data for a in reply.artifacts}
+        assert artifacts["periods.png"].startswith(b"\x89PNG")
+        periods = [float(x) for x in artifacts["periods.csv"].decode().split()]
+        assert periods == pytest.approx([0.1] * 4, abs=1e-6)  # simulated, not wall, periods
+        assert any("stopped at 15 cm" in line for line in node.logs.take())
+    finally:
+        node.close()
+
+
+def test_shutdown_runs_hooks_and_returns_artifacts(launcher):
+    code = (
+        "import rospy\n"
+        "rospy.init_node('spinner')\n"
+        "rospy.on_shutdown(lambda: open('bye.txt', 'w').write('hooked'))\n"
+        "rospy.spin()\n"
+    )
+    reply, node = run_script(launcher, code, "spinner")
+    try:
+        assert isinstance(reply, Yield) and reply.wake_at_s is None  # spin: wake on messages
+        exited = node.shutdown("finished: duration reached")
+        assert exited.outcome is Outcome.SHUTDOWN
+        assert {a.name: a.data for a in exited.artifacts} == {"bye.txt": b"hooked"}
+    finally:
+        node.close()
+
+
+def test_driving_a_finished_node_is_a_usage_error(launcher):
+    reply, node = run_script(launcher, "x = 1\n")
+    try:
+        assert isinstance(reply, Exited)
+        with pytest.raises(NodeUsageError, match="cannot go from exited to running"):
+            node.wake(0.1, [])
+        assert node.shutdown("again") is reply  # idempotent
+    finally:
+        node.close()
+
+
+def test_without_bubblewrap_the_launcher_refuses(monkeypatch):
+    monkeypatch.setenv("PATH", "/nonexistent")
+    with pytest.raises(SandboxUnavailable, match="--unsafe-no-sandbox"):
+        Launcher(pool_size=0)
+
+
+def test_unsafe_mode_runs_and_says_danger_every_time(caplog):
+    launcher = Launcher(pool_size=0, unsafe_no_sandbox=True)
+    try:
+        for name in ("first", "second"):
+            with caplog.at_level(logging.WARNING, logger="robodojo.sandbox"):
+                node = launcher.start(name)
+            reply = node.load("def step(obs):\n    return (0.1, 0.0)\n", "u.py", Api.STEP,
+                              crowbot_info(name))  # fmt: skip
+            assert isinstance(reply, Yield), reply
+            node.close()
+        dangers = [r.getMessage() for r in caplog.records if DANGER in r.getMessage()]
+        assert len(dangers) == 2
+    finally:
+        launcher.close()
