@@ -174,11 +174,16 @@ class NodeProcess:
         """Wait for the child's Ready; False if it died or took longer than its budget."""
         if self.state is NodeState.IDLE:
             return True
-        reply = self._receive(timeout_s or self.limits.startup_budget_s, "start-up")
+        if self.state is not NodeState.STARTING:
+            return False
+        self._expect(timeout_s or self.limits.startup_budget_s, "start-up")
+        reply = self._receive_until(self._deadline)
         if isinstance(reply, Ready):
             self.startup_ms = reply.startup_ms
             self._move(NodeState.IDLE)
             return True
+        if self.state is not NodeState.EXITED:
+            self._overdue()
         return False
 
     # ----------------------------------------------------------------------------- driving
@@ -190,14 +195,50 @@ class NodeProcess:
         self.time_s = info.start_time_s
         self._move(NodeState.RUNNING)
         self._send(Load(code=code, filename=filename, api=api, info=info))
-        return self._await_yield(self.limits.first_step_budget_s, "first step")
+        self._expect(self.limits.first_step_budget_s, "first step")
+        return self.poll_reply(None)
 
     def wake(self, time_s: float, deliveries: list[Envelope]) -> Yield | Exited:
-        """Wake the sleeping node at simulated (or wall) time `time_s` with new messages."""
+        """Wake the sleeping node at simulated (or wall) time `time_s` with new messages and
+        wait for it to sleep again (or end)."""
+        self.begin_wake(time_s, deliveries)
+        return self.poll_reply(None)
+
+    def begin_wake(self, time_s: float, deliveries: list[Envelope]) -> None:
+        """Wake the node without waiting; collect its reply with `poll_reply` (a realtime run
+        drives several nodes at once this way)."""
         self.time_s = time_s
         self._move(NodeState.RUNNING)
         self._send(Wake(time_s=time_s, deliveries=deliveries))
-        return self._await_yield(self.limits.step_budget_s, "step")
+        self._expect(self.limits.step_budget_s, "step")
+
+    def poll_reply(self, timeout_s: float | None) -> Yield | Exited | None:
+        """The running node's reply, waiting at most `timeout_s` (None: until its budget runs
+        out). None means it is still computing within its budget."""
+        if self.state is not NodeState.RUNNING:
+            raise NodeUsageError(f"node {self.name} is {self.state}, not waiting for a reply")
+        until = (
+            self._deadline
+            if timeout_s is None
+            else min(self._deadline, time.monotonic() + timeout_s)
+        )
+        reply = self._receive_until(until)
+        if isinstance(reply, Yield):
+            self._move(NodeState.SLEEPING)
+            return reply
+        if isinstance(reply, Exited):
+            self._finish(reply)
+            return reply
+        if self.state is NodeState.EXITED:
+            return self.exited
+        if time.monotonic() >= self._deadline:
+            return self._overdue()
+        return None
+
+    @property
+    def reply_fds(self) -> tuple[int, int]:
+        """The fds that become readable when the node replies or logs (for a caller's poll)."""
+        return (self._fds[1], self._fds[2]) if self._fds else ()
 
     def shutdown(self, reason: str) -> Exited:
         """Ask the node to stop (on_shutdown hooks run, artifacts are collected)."""
@@ -207,8 +248,9 @@ class NodeProcess:
             return self.kill(f"stopped: {reason}", Outcome.SHUTDOWN)
         self._move(NodeState.RUNNING)
         self._send(Shutdown(reason=reason))
-        reply = self._await_yield(self.limits.shutdown_budget_s, "shutdown")
-        while isinstance(reply, Yield):  # it slept again: it may not, the run is over
+        self._expect(self.limits.shutdown_budget_s, "shutdown")
+        reply = self.poll_reply(None)
+        if isinstance(reply, Yield):  # it slept again: it may not, the run is over
             reply = self.kill(
                 f"stopped: {reason} (it kept running after shutdown)", Outcome.SHUTDOWN
             )
@@ -239,19 +281,25 @@ class NodeProcess:
         with contextlib.suppress(OSError):
             self._writer.send(frame)
 
-    def _await_yield(self, budget_s: float, what: str) -> Yield | Exited:
-        reply = self._receive(budget_s, what)
-        if isinstance(reply, Yield):
-            self._move(NodeState.SLEEPING)
-            return reply
-        if isinstance(reply, Exited):
-            self._finish(reply)
-            return reply
-        return self._end_reply()
+    def _expect(self, budget_s: float, what: str) -> None:
+        """Start the clock on a reply: it must come within `budget_s`."""
+        self._budget_s, self._budget_what = budget_s, what
+        self._deadline = time.monotonic() + budget_s
 
-    def _receive(self, budget_s: float, what: str) -> object | None:
-        """The next frame, or None after killing/recording a dead or overdue child."""
-        deadline = time.monotonic() + budget_s
+    def _overdue(self) -> Exited:
+        return self.kill(
+            f"node {self.name} exceeded its {self._budget_s:g} s {self._budget_what} budget "
+            f"at t={self.time_s:.3f} s"
+        )
+
+    def _end_reply(self) -> Exited:
+        if self.exited is None:
+            self._finish(Exited(outcome=Outcome.CRASHED, reason=f"node {self.name} ended"))
+        return self.exited
+
+    def _receive_until(self, until: float) -> object | None:
+        """The next frame if one arrives before monotonic time `until`; None if not (or if the
+        child died, which is then recorded as its end). Drains the log stream meanwhile."""
         poller, proto_fd, log_fd = self._poller, self._fds[1], self._fds[2]
         while True:
             try:
@@ -261,15 +309,15 @@ class NodeProcess:
                 return None
             if frame is not None:
                 return frame
-            remaining = deadline - time.monotonic()
-            if remaining <= 0:
-                self.kill(
-                    f"node {self.name} exceeded its {budget_s:g} s {what} budget at "
-                    f"t={self.time_s:.3f} s"
-                )
+            if not self._proto_open:
+                if self._log_open:
+                    self.logs.drain()
+                self._finish(Exited(outcome=Outcome.CRASHED, reason=self._death_reason()))
                 return None
-            events = poller.poll(remaining * 1000.0)
-            for fd, _event in events:
+            remaining = until - time.monotonic()
+            if remaining <= 0:
+                return None
+            for fd, _event in poller.poll(remaining * 1000.0):
                 if fd == log_fd:
                     if not self.logs.drain():
                         poller.unregister(log_fd)
@@ -277,11 +325,6 @@ class NodeProcess:
                 elif fd == proto_fd and not self._reader.feed():
                     poller.unregister(proto_fd)
                     self._proto_open = False
-            if not self._proto_open and self._reader.pending() is None:
-                if self._log_open:
-                    self.logs.drain()
-                self._finish(Exited(outcome=Outcome.CRASHED, reason=self._death_reason()))
-                return None
 
     def _death_reason(self) -> str:
         try:
@@ -303,11 +346,6 @@ class NodeProcess:
                 f"({_signal_name(signal_number)}) at t={self.time_s:.3f} s"
             )
         return f"node {self.name} died unexpectedly (exit code {code}) at t={self.time_s:.3f} s"
-
-    def _end_reply(self) -> Exited:
-        if self.exited is None:
-            self._finish(Exited(outcome=Outcome.CRASHED, reason=f"node {self.name} ended"))
-        return self.exited
 
     def _finish(self, exited: Exited) -> None:
         self.exited = exited
