@@ -251,6 +251,10 @@ class Simulation:
         lights[index] = LightSource(old.name, float(x), float(y), old.z, old.intensity, True)
         self.lights = tuple(lights)
 
+    def next_publication_s(self) -> float:
+        """Simulated time [s] at which the next sensor message falls due."""
+        return self._earliest_due_ns / NS_PER_S
+
     def drain_events(self) -> list[SimEvent]:
         """Contact and bounds events since the last call."""
         events, self._events = self._events, []

@@ -84,6 +84,9 @@ class RobotModel:
     commands: ClassVar[dict[str, tuple[type, str]]]
     # name -> description for each sensor topic (the sensor object supplies type and rate).
     sensor_descriptions: ClassVar[dict[str, str]]
+    # Frames the sensors stamp their messages with: frame -> (x [m], y [m], yaw [rad]) in the
+    # robot frame, or (x, y, yaw, roll [rad]) for a scanner whose angles grow clockwise.
+    frames: ClassVar[dict[str, tuple[float, ...]]] = {}
 
     def build_sensors(self) -> dict[str, Sensor]:
         """A fresh sensor object per published topic."""
@@ -98,6 +101,10 @@ class RobotModel:
         """Act on a (type-checked, finite) command message. Raise CommandError for content the
         robot cannot accept."""
         raise NotImplementedError
+
+    def sensor_frames(self, state: RobotState) -> dict[str, tuple[float, ...]]:
+        """The sensor frames where they are now (a servo turns one; most never move)."""
+        return self.frames
 
     def advance(self, state: RobotState, dt_s: float, time_s: float) -> None:
         """Per physics tick, for actuators other than the wheels (servo slew, buzzer timer)."""

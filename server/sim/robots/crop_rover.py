@@ -72,6 +72,9 @@ class CropRover(RobotModel):
         "u": (Float32, "fuzzy control word -100..100: negative steers left, positive right"),
         "cmd_vel": (Twist, "velocity command: linear.x [m/s], angular.z [rad/s]"),
     }
+    # The YDLidar's angles grow clockwise from the rear (Figure 5): the frame is turned half a
+    # circle and mounted upside down, so ROS tools draw beam a in robot direction pi - a.
+    frames: ClassVar = {"laser": (0.0, 0.0, math.pi, math.pi), "imu_link": (0.0, 0.0, 0.0)}
     sensor_descriptions: ClassVar = {
         "scan": "360 deg LiDAR scan: 0 rad at the rear, left side (0, pi), right side (-pi, 0)",
         "psi": "yaw from the BNO055 [rad], drifts slowly",

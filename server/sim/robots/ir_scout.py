@@ -137,6 +137,11 @@ class IrScout(RobotModel):
         elif topic == "cmd_vel":
             motors.command(*clamp_twist(message.linear.x, message.angular.z, self.limits))
 
+    def sensor_frames(self, state: RobotState) -> dict[str, tuple[float, ...]]:
+        # The ranger turns with the servo: 90 degrees points it ahead.
+        servo_rad = math.radians(state.servo_angle_deg - 90.0)
+        return {"ir_link": (IR_MOUNT.x_m, IR_MOUNT.y_m, IR_MOUNT.yaw_rad + servo_rad)}
+
     def advance(self, state: RobotState, dt_s: float, time_s: float) -> None:
         super().advance(state, dt_s, time_s)
         error = state.servo_target_deg - state.servo_angle_deg

@@ -40,6 +40,7 @@ MAX_WHEEL_ACCEL_M_S2 = 1.0  # [m/s^2]
 RATE_ODOM_HZ = 20.0  # [Hz] create driver's odometry rate (assumption)
 RATE_IMU_HZ = 50.0  # [Hz] Gazebo IMU plugin default update rate in the thesis's setup
 RATE_BUMPER_HZ = 20.0  # [Hz] sensor stream polling
+ULTRASONIC_RING = UltrasonicRing()  # its geometry, for the sensor frames
 
 
 class TurtleBot(RobotModel):
@@ -59,6 +60,14 @@ class TurtleBot(RobotModel):
     )
     commands: ClassVar = {
         "cmd_vel": (Twist, "velocity command: linear.x [m/s], angular.z [rad/s]"),
+    }
+    frames: ClassVar = {
+        "camera_depth_frame": (0.0, 0.0, 0.0),
+        "imu_link": (0.0, 0.0, 0.0),
+        **{
+            ranger.frame_id: (ranger.mount.x_m, ranger.mount.y_m, ranger.mount.yaw_rad)
+            for ranger in ULTRASONIC_RING.rangers
+        },
     }
     sensor_descriptions: ClassVar = {
         "odom": "wheel odometry (drifts): pose in the odom frame and body velocities",
