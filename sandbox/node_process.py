@@ -285,6 +285,7 @@ class NodeProcess:
         """The next frame if one arrives before monotonic time `until`; None if not (or if the
         child died, which is then recorded as its end). Drains the log stream meanwhile."""
         poller, proto_fd, log_fd = self._poller, self._fds[1], self._fds[2]
+        polled_once = False
         while True:
             try:
                 frame = self._reader.pending()
@@ -300,7 +301,10 @@ class NodeProcess:
                 return None
             remaining = until - time.monotonic()
             if remaining <= 0:
-                return None
+                if polled_once:
+                    return None
+                remaining = 0.0  # a deadline already past still reads what has arrived
+            polled_once = True
             for fd, _event in poller.poll(remaining * 1000.0):
                 if fd == log_fd:
                     if not self.logs.drain():

@@ -1,0 +1,143 @@
+"""The topic bus of one run: every message from the robot and from every node passes here.
+
+Any node may subscribe to any topic; each subscriber has its own inbox, bounded per topic
+(`QUEUE_SIZE`, oldest dropped first, like a ROS subscriber's queue), delivered at the node's
+next wake in the order messages arrived. The bus also knows the graph - nodes, topics, their
+publishers and subscribers, and measured rates - for an rqt_graph-like view.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass, field
+
+from sandbox.protocol import Envelope, TopicDecl
+
+QUEUE_SIZE = 100  # [messages] per topic per subscriber between two wakes
+RATE_WINDOW = 50  # [messages] recent arrival times kept per topic to measure its rate
+ROBOT = "robot"  # the publisher name of everything the robot (sim or hardware) publishes
+RUN = "run"  # the publisher name of what the run itself publishes (the goal)
+
+
+@dataclass(slots=True)
+class _Topic:
+    type: str
+    publishers: set[str] = field(default_factory=set)
+    subscribers: set[str] = field(default_factory=set)
+    count: int = 0
+    recent: deque = field(default_factory=lambda: deque(maxlen=RATE_WINDOW))
+
+    def rate_hz(self) -> float | None:
+        if len(self.recent) < 2 or self.recent[-1] <= self.recent[0]:
+            return None
+        return (len(self.recent) - 1) / (self.recent[-1] - self.recent[0])
+
+
+@dataclass(slots=True)
+class _Inbox:
+    queues: dict[str, deque] = field(default_factory=dict)  # topic -> deque[(seq, t, env)]
+    pending: int = 0
+    dropped: int = 0
+
+
+class TopicTypeMismatch(ValueError):
+    pass
+
+
+class TopicBus:
+    def __init__(self) -> None:
+        self.topics: dict[str, _Topic] = {}
+        self.nodes: list[str] = []
+        self._inboxes: dict[str, _Inbox] = {}
+        self._seq = 0
+
+    # ----------------------------------------------------------------------------- graph
+    def add_node(self, name: str) -> None:
+        if name not in self._inboxes:
+            self.nodes.append(name)
+            self._inboxes[name] = _Inbox()
+
+    def declare_topic(self, name: str, type_name: str, publisher: str | None = None) -> None:
+        topic = self.topics.get(name)
+        if topic is None:
+            topic = self.topics[name] = _Topic(type_name)
+        elif topic.type != type_name:
+            raise TopicTypeMismatch(f"topic '{name}' carries {topic.type}, not {type_name}")
+        if publisher is not None:
+            topic.publishers.add(publisher)
+
+    def declare(self, node: str, advertised: list[TopicDecl], subscribed: list[TopicDecl]) -> None:
+        """Record what a node said it publishes and subscribes to (from its Yield)."""
+        for decl in advertised:
+            self.declare_topic(decl.name, decl.type, node)
+        for decl in subscribed:
+            self.declare_topic(decl.name, decl.type)
+            self.topics[decl.name].subscribers.add(node)
+            self._inboxes[node].queues.setdefault(decl.name, deque(maxlen=QUEUE_SIZE))
+
+    # ----------------------------------------------------------------------------- traffic
+    def publish(self, publisher: str, envelope: Envelope, time_s: float) -> None:
+        """Route one message to every subscriber's inbox (not back to its publisher)."""
+        topic = self.topics.get(envelope.topic)
+        if topic is None:
+            self.declare_topic(envelope.topic, envelope.type, publisher)
+            topic = self.topics[envelope.topic]
+        elif topic.type != envelope.type:
+            raise TopicTypeMismatch(
+                f"topic '{envelope.topic}' carries {topic.type}, not {envelope.type}"
+            )
+        topic.publishers.add(publisher)
+        topic.count += 1
+        topic.recent.append(time_s)
+        self._seq += 1
+        for name in topic.subscribers:
+            if name == publisher:
+                continue
+            inbox = self._inboxes[name]
+            queue = inbox.queues[envelope.topic]
+            if len(queue) == queue.maxlen:
+                inbox.dropped += 1
+                inbox.pending -= 1
+            queue.append((self._seq, time_s, envelope))
+            inbox.pending += 1
+
+    def has_pending(self, node: str) -> bool:
+        return self._inboxes[node].pending > 0
+
+    def take(self, node: str) -> tuple[list[Envelope], float | None]:
+        """Everything waiting for `node`, in arrival order, and the publication time of the
+        newest robot message among them (for command latency), or None."""
+        inbox = self._inboxes[node]
+        if not inbox.pending:
+            return [], None
+        items = []
+        for queue in inbox.queues.values():
+            items.extend(queue)
+            queue.clear()
+        inbox.pending = 0
+        items.sort(key=lambda item: item[0])
+        newest_robot = None
+        for _, time_s, envelope in items:
+            if ROBOT in self.topics[envelope.topic].publishers:
+                newest_robot = time_s
+        return [envelope for _, _, envelope in items], newest_robot
+
+    def dropped(self, node: str) -> int:
+        return self._inboxes[node].dropped
+
+    def graph(self) -> dict:
+        """Nodes, topics with type, publishers, subscribers, message count and measured rate."""
+        return {
+            "nodes": [ROBOT, *self.nodes],
+            "topics": [
+                {
+                    "name": name,
+                    "type": topic.type,
+                    "publishers": sorted(topic.publishers),
+                    "subscribers": sorted(topic.subscribers),
+                    "messages": topic.count,
+                    "rate_hz": topic.rate_hz(),
+                }
+                for name, topic in sorted(self.topics.items())
+            ],
+        }

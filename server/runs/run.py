@@ -1,0 +1,533 @@
+"""A run: a robot backend, one or more sandboxed nodes, a clock, a topic bus and a recording.
+
+    run = Run(spec, launcher, out_dir)
+    result = run.execute()          # blocking: call it from a worker thread or the CLI
+    run.stop() / run.pause() / run.press_button(True) / ...   # from any thread, meanwhile
+
+The loop itself lives in server/runs/clocks.py (lockstep and realtime); this module owns the
+lifecycle, the nodes, routing between them and the robot, controls, and the result. Nothing
+that goes wrong in one run escapes `execute()`: a node that raises or is killed, a recorder
+that fails, a simulator that raises - each ends this run with a reason and leaves others alone.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import queue
+import threading
+import time
+import uuid
+from collections import deque
+from dataclasses import dataclass, field
+from enum import StrEnum
+from pathlib import Path
+
+from sandbox.launcher import Launcher
+from sandbox.msgs import Time, get_message_class
+from sandbox.msgs.geometry_msgs import Point, Pose, PoseStamped, Quaternion
+from sandbox.msgs.std_msgs import Header
+from sandbox.node_process import NodeProcess
+from sandbox.protocol import Clock, Envelope, Exited, NodeInfo, Outcome, RobotTopic, Yield
+from server.runs.bus import ROBOT, RUN, TopicBus
+from server.runs.metrics import NodeMetrics
+from server.runs.recorder import Recorder
+from server.runs.spec import NodeSpec, RunSpec
+from server.runs.state import RunState, check_transition
+from server.runs.tf import tf_message
+from server.sim import Pose2D, Simulation
+from server.sim.robots.base import CommandError, Direction
+from server.sim.simulation import EventKind, SimulationError
+
+log = logging.getLogger("robodojo.runs")
+
+NS = 1_000_000_000
+GOAL_TOPIC = "goal"  # RViz's "2D Nav Goal" idea: the run publishes the goal pose here
+TF_PERIOD_NS = NS // 30  # [ns] /tf recorded at 30 Hz: smooth in Foxglove, small on disk
+MAP_MARGIN_M = 0.5  # [m] beyond the world's bounds by this much, the robot left the map
+LOG_LINES_KEPT = 2000  # per node in memory (the recording keeps them all)
+
+
+class FaultKind(StrEnum):
+    DROP_TOPIC = "drop_topic"  # a sensor goes silent
+    FREEZE_TOPIC = "freeze_topic"  # a sensor repeats its last reading
+    STALL_MOTORS = "stall_motors"  # the wheels stop answering commands
+
+
+@dataclass(frozen=True, slots=True)
+class Fault:
+    kind: FaultKind
+    topic: str | None
+    until_ns: int
+
+
+@dataclass
+class NodeSlot:
+    """The run's view of one node."""
+
+    spec: NodeSpec
+    process: NodeProcess | None = None
+    wake_at_ns: int | None = 0  # None: spinning (wake on messages)
+    done: bool = False
+    exited: Exited | None = None
+    last_wake_ns: int | None = None
+    newest_sensor_s: float | None = None  # publication time of the newest robot message seen
+    woken_at_wall: float = 0.0
+    metrics: NodeMetrics = field(default_factory=NodeMetrics)
+    logs: deque = field(default_factory=lambda: deque(maxlen=LOG_LINES_KEPT))
+
+    @property
+    def name(self) -> str:
+        return self.spec.name
+
+
+@dataclass
+class RunResult:
+    run_id: str
+    state: RunState
+    reason: str
+    duration_s: float
+    wall_s: float
+    metrics: dict
+    nodes: dict[str, dict]
+    paths: dict[str, str]
+    graph: dict
+
+    def summary(self) -> dict:
+        """The result in one JSON-able dict, without histograms (metrics.json has them)."""
+        return {
+            "run_id": self.run_id,
+            "state": str(self.state),
+            "reason": self.reason,
+            "duration_s": round(self.duration_s, 6),
+            "wall_s": round(self.wall_s, 3),
+            "metrics": self.metrics,
+            "nodes": {name: _without_histograms(node) for name, node in self.nodes.items()},
+            "paths": self.paths,
+        }
+
+
+def _without_histograms(value: object) -> object:
+    if isinstance(value, dict):
+        return {k: _without_histograms(v) for k, v in value.items() if k != "histogram"}
+    return value
+
+
+class RunEnd(Exception):
+    """Raised inside the loop to end the run: the state and the sentence that says why."""
+
+    def __init__(self, state: RunState, reason: str) -> None:
+        super().__init__(reason)
+        self.state = state
+        self.reason = reason
+
+
+class Run:
+    def __init__(
+        self,
+        spec: RunSpec,
+        launcher: Launcher,
+        out_dir: str | Path,
+        run_id: str | None = None,
+    ) -> None:
+        spec.validate()
+        self.spec = spec
+        self.launcher = launcher
+        self.run_id = run_id or uuid.uuid4().hex[:12]
+        self.out_dir = Path(out_dir)
+        self.state = RunState.CREATED
+        self.reason = ""
+        self.time_ns = 0
+        self.duration_ns = round(spec.duration_s * NS)
+        self._controls: queue.SimpleQueue = queue.SimpleQueue()
+        self._state_lock = threading.Lock()
+        self.faults: list[Fault] = []
+        self.slots = {node.name: NodeSlot(node) for node in spec.nodes}
+        self.bus = TopicBus()
+        self.sim: Simulation | None = None
+        self.recorder: Recorder | None = None
+        self._next_tf_ns = 0
+        self._frozen: dict[str, Envelope] = {}
+        self._paused_event = threading.Event()
+
+    # ----------------------------------------------------------------------------- controls
+    # Called from other threads; applied by the loop between two steps.
+    def stop(self, reason: str = "stopped by the user") -> None:
+        self._controls.put(("stop", reason))
+
+    def pause(self) -> None:
+        if self.spec.clock is not Clock.LOCKSTEP:
+            raise ValueError("only a lockstep (simulated-time) run can pause; stop it instead")
+        self._controls.put(("pause", None))
+
+    def resume(self) -> None:
+        self._controls.put(("resume", None))
+
+    def press_button(self, pressed: bool) -> None:
+        self._controls.put(("button", bool(pressed)))
+
+    def move_light(self, name: str, x: float, y: float) -> None:
+        self._controls.put(("light", (name, float(x), float(y))))
+
+    def set_goal(self, x: float, y: float, yaw: float = 0.0) -> None:
+        if not all(math.isfinite(v) for v in (x, y, yaw)):
+            raise ValueError(f"a goal needs finite numbers, got ({x}, {y}, {yaw})")
+        self._controls.put(("goal", (float(x), float(y), float(yaw))))
+
+    def inject_fault(self, kind: FaultKind | str, topic: str | None, duration_s: float) -> None:
+        kind = FaultKind(kind)
+        if kind is not FaultKind.STALL_MOTORS and not topic:
+            raise ValueError(f"fault {kind} needs the topic it affects")
+        if not (math.isfinite(duration_s) and duration_s > 0):
+            raise ValueError(f"a fault lasts a positive number of seconds, got {duration_s}")
+        self._controls.put(("fault", (kind, topic, duration_s)))
+
+    @property
+    def progress(self) -> tuple[float, float]:
+        """(run time [s], duration [s])."""
+        return self.time_ns / NS, self.spec.duration_s
+
+    def _apply_controls(self) -> None:
+        while True:
+            try:
+                action, value = self._controls.get_nowait()
+            except queue.Empty:
+                return
+            self._apply_control(action, value)
+
+    def _apply_control(self, action: str, value: object) -> None:
+        if action == "stop":
+            raise RunEnd(RunState.INTERRUPTED, f"interrupted: {value}")
+        if action == "pause" and self.state is RunState.RUNNING:
+            self._move(RunState.PAUSED)
+        elif action == "resume" and self.state is RunState.PAUSED:
+            self._move(RunState.RUNNING)
+        elif action == "button":
+            self.sim.press_button(value)
+        elif action == "light":
+            name, x, y = value
+            try:
+                self.sim.move_light(name, x, y)
+            except SimulationError as error:
+                log.info("run %s: light not moved: %s", self.run_id, error)
+        elif action == "goal":
+            self._publish_goal(*value)
+        elif action == "fault":
+            kind, topic, duration_s = value
+            fault = Fault(kind, topic, self.time_ns + round(duration_s * NS))
+            self.faults.append(fault)
+            if kind is FaultKind.STALL_MOTORS:
+                self._stall_motors()
+
+    def wait_while_paused(self, timeout_s: float) -> None:
+        """Block up to `timeout_s` for a control while paused (the loop calls this)."""
+        try:
+            action, value = self._controls.get(timeout=timeout_s)
+        except queue.Empty:
+            return
+        self._apply_control(action, value)
+
+    # ----------------------------------------------------------------------------- lifecycle
+    def _move(self, new: RunState) -> None:
+        with self._state_lock:
+            check_transition(self.state, new)
+            self.state = new
+
+    def execute(self) -> RunResult:
+        """Run to the end and return the result. Never raises for anything a node does."""
+        from server.runs.clocks import run_lockstep, run_realtime
+
+        wall_start = time.monotonic()
+        end_state, reason = RunState.FAILED, "failed: the run did not start"
+        self._move(RunState.STARTING)
+        try:
+            self._prepare()
+            self._start_nodes()
+            self._move(RunState.RUNNING)
+            loop = run_lockstep if self.spec.clock is Clock.LOCKSTEP else run_realtime
+            loop(self)
+            end_state, reason = RunState.FINISHED, "finished: duration reached"
+        except RunEnd as end:
+            end_state, reason = end.state, end.reason
+        except Exception as error:  # a fault of ours must end this run, not the server
+            log.exception("run %s failed inside the engine", self.run_id)
+            end_state, reason = RunState.FAILED, f"failed: internal error ({error!r})"
+        if self.state is not RunState.STOPPING:
+            self._move(RunState.STOPPING)
+        return self._finish(end_state, reason, time.monotonic() - wall_start)
+
+    def _prepare(self) -> None:
+        spec = self.spec
+        spawn = Pose2D(*spec.initial_pose) if spec.initial_pose else spec.spawn
+        self.sim = Simulation(spec.robot, spec.world, seed=spec.seed, spawn=spawn)
+        self.out_dir.mkdir(parents=True, exist_ok=True)
+        self.recorder = Recorder(self.out_dir, self.run_id)
+        for topic in self.sim.topics:
+            self.bus.declare_topic(topic.name, topic.type_name, ROBOT if topic.rate_hz else None)
+            self.recorder.add_topic(topic.name, topic.type_name)
+        self.bus.declare_topic(GOAL_TOPIC, PoseStamped._type, RUN)
+        self.recorder.add_topic(GOAL_TOPIC, PoseStamped._type)
+        self.recorder.add_topic("tf", "tf2_msgs/TFMessage")
+        if spec.light_position is not None:
+            movable = [light.name for light in self.sim.lights if light.movable]
+            if movable:
+                self.sim.move_light(movable[0], *spec.light_position)
+        for published in self.sim.reset():
+            self._from_robot(published.topic, published.message, 0.0)
+        if spec.goal is not None:
+            self._publish_goal(*spec.goal)
+
+    def _node_info(self, node: NodeSpec) -> NodeInfo:
+        topics = [
+            RobotTopic(t.name, t.type_name, str(t.direction), t.rate_hz) for t in self.sim.topics
+        ]
+        topics.append(RobotTopic(GOAL_TOPIC, PoseStamped._type, "publish", None))
+        velocity = next(
+            (
+                t.name
+                for t in self.sim.topics
+                if t.direction is Direction.SUBSCRIBE and t.type_name == "geometry_msgs/Twist"
+            ),
+            None,
+        )
+        return NodeInfo(
+            node_name=node.name,
+            robot=self.spec.robot,
+            robot_topics=topics,
+            velocity_topic=velocity,
+            clock=self.spec.clock,
+            start_time_s=0.0,
+            params=dict(self.spec.params),
+            allow_new_topics=len(self.spec.nodes) > 1,
+        )
+
+    def _start_nodes(self) -> None:
+        for slot in self.slots.values():
+            self.bus.add_node(slot.name)
+            slot.process = self.launcher.start(slot.name)
+        replies = []
+        for slot in self.slots.values():
+            node = slot.spec
+            reply = slot.process.load(node.code, node.filename, node.api, self._node_info(node))
+            replies.append((slot, reply))
+        # Every node's subscriptions are known before anything published at start-up is
+        # routed, so launch-file order does not lose a first message (as a latched topic).
+        for slot, reply in replies:
+            if isinstance(reply, Yield):
+                self.bus.declare(slot.name, reply.advertised, reply.subscribed)
+        for slot, reply in replies:
+            self.handle_reply(slot, reply, timed=False)
+
+    def _finish(self, end_state: RunState, reason: str, wall_s: float) -> RunResult:
+        for slot in self.slots.values():
+            self._end_node(slot, reason)
+        if self.recorder is not None:
+            if self.recorder.error and end_state is RunState.FINISHED:
+                end_state, reason = RunState.FAILED, f"failed: {self.recorder.error}"
+            metrics = self.metrics()
+            self.recorder.write_json("metrics", metrics)
+            self.recorder.write_json("graph", self.bus.graph())
+            paths = self.recorder.close()
+        else:
+            metrics, paths = self.metrics(), {}
+        self.reason = reason
+        self._move(end_state)
+        return RunResult(
+            run_id=self.run_id,
+            state=end_state,
+            reason=reason,
+            duration_s=self.time_ns / NS,
+            wall_s=wall_s,
+            metrics=metrics["run"],
+            nodes=metrics["nodes"],
+            paths=paths,
+            graph=self.bus.graph(),
+        )
+
+    def _end_node(self, slot: NodeSlot, reason: str) -> None:
+        process = slot.process
+        if process is None:
+            return
+        try:
+            exited = slot.exited or process.shutdown(reason)
+            slot.exited = exited
+            self._collect_logs(slot)
+            if self.recorder is not None and exited.artifacts:
+                self.recorder.write_artifacts(
+                    slot.name, [(a.name, a.data) for a in exited.artifacts]
+                )
+            for note in exited.notes:
+                slot.logs.append(f"[artifacts] {note}")
+        finally:
+            process.close()
+            slot.process = None
+
+    def metrics(self) -> dict:
+        state = self.sim.state if self.sim is not None else None
+        run = {
+            "collisions": state.contact_count if state else 0,
+            "distance_travelled_m": state.distance_travelled_m if state else 0.0,
+            "time_out_of_bounds_s": state.time_out_of_bounds_s if state else 0.0,
+        }
+        nodes = {}
+        for slot in self.slots.values():
+            summary = slot.metrics.summary()
+            summary["outcome"] = str(slot.exited.outcome) if slot.exited else None
+            summary["dropped_messages"] = (
+                self.bus.dropped(slot.name) if slot.name in self.bus.nodes else 0
+            )
+            nodes[slot.name] = summary
+        return {"run": run, "nodes": nodes}
+
+    # ----------------------------------------------------------------------------- routing
+    def handle_reply(self, slot: NodeSlot, reply: Yield | Exited, timed: bool = True) -> None:
+        """Act on what a node said when it went back to sleep (or ended). `timed`: the reply
+        answers a wake, so its wall time is a step's compute time (not start-up)."""
+        if timed:
+            slot.metrics.compute.add(time.perf_counter() - slot.woken_at_wall)
+        self._collect_logs(slot)
+        if isinstance(reply, Yield):
+            self.bus.declare(slot.name, reply.advertised, reply.subscribed)
+            self._from_node(slot, reply.published)
+            slot.wake_at_ns = None if reply.wake_at_s is None else round(reply.wake_at_s * NS)
+            return
+        self._from_node(slot, reply.published)
+        slot.exited, slot.done = reply, True
+        if reply.error is not None:  # the student's traceback belongs in the node's log
+            lines = reply.error.traceback.rstrip("\n").split("\n")
+            slot.logs.extend(lines)
+            self.recorder.write_log(slot.name, lines)
+        if reply.outcome is Outcome.FINISHED:
+            if all(s.done for s in self.slots.values()):
+                raise RunEnd(RunState.FINISHED, "finished: every node ended")
+            return
+        if reply.outcome is Outcome.ERROR and reply.error is not None:
+            where = f" at line {reply.error.line}" if reply.error.line else ""
+            raise RunEnd(
+                RunState.FAILED, f"failed: node {slot.name} raised {reply.error.type}{where}"
+            )
+        raise RunEnd(RunState.FAILED, f"failed: {reply.reason}")
+
+    def wake(self, slot: NodeSlot, time_ns: int) -> None:
+        """Lockstep: wake one node now and handle its reply."""
+        self.begin_wake(slot, time_ns)
+        self.handle_reply(slot, slot.process.poll_reply(None))
+
+    def begin_wake(self, slot: NodeSlot, time_ns: int) -> None:
+        deliveries, newest_sensor_s = self.bus.take(slot.name)
+        if newest_sensor_s is not None:
+            slot.newest_sensor_s = newest_sensor_s
+        if slot.last_wake_ns is not None:
+            slot.metrics.period.add((time_ns - slot.last_wake_ns) / NS)
+        slot.last_wake_ns = time_ns
+        slot.metrics.wakes += 1
+        slot.woken_at_wall = time.perf_counter()
+        slot.process.begin_wake(time_ns / NS, deliveries)
+
+    def _from_node(self, slot: NodeSlot, published: list[Envelope]) -> None:
+        now_s = self.time_ns / NS
+        for envelope in published:
+            slot.metrics.published += 1
+            self.bus.publish(slot.name, envelope, now_s)
+            self.recorder.record(envelope.topic, envelope.type, self.time_ns, envelope.data)
+            if self.sim.robot.commands.get(envelope.topic) is not None:
+                self._command_robot(slot, envelope)
+
+    def _command_robot(self, slot: NodeSlot, envelope: Envelope) -> None:
+        if any(f.kind is FaultKind.STALL_MOTORS for f in self.faults):
+            return
+        try:
+            message = get_message_class(envelope.type).deserialize(envelope.data)
+            self.sim.apply(envelope.topic, message)
+        except (SimulationError, CommandError, ValueError) as error:
+            slot.metrics.rejected_commands += 1
+            slot.logs.append(f"[robot] rejected {envelope.topic}: {error}")
+            if self.recorder is not None:
+                self.recorder.write_log(slot.name, [f"[robot] rejected {envelope.topic}: {error}"])
+            return
+        if slot.newest_sensor_s is not None:
+            slot.metrics.latency.add(self.time_ns / NS - slot.newest_sensor_s)
+
+    def _from_robot(self, topic: str, message: object, time_s: float) -> None:
+        envelope = Envelope(topic, message._type, message.serialize())
+        if self.faults and self._faulted(envelope):
+            return
+        self.bus.publish(ROBOT, self._frozen.get(topic, envelope), time_s)
+        self.recorder.record(topic, envelope.type, round(time_s * NS), envelope.data)
+
+    def _faulted(self, envelope: Envelope) -> bool:
+        self.faults = [f for f in self.faults if f.until_ns > self.time_ns]
+        for fault in self.faults:
+            if fault.topic != envelope.topic:
+                continue
+            if fault.kind is FaultKind.DROP_TOPIC:
+                return True
+            if fault.kind is FaultKind.FREEZE_TOPIC:
+                self._frozen.setdefault(envelope.topic, envelope)
+                return False
+        self._frozen.pop(envelope.topic, None)
+        return False
+
+    def _stall_motors(self) -> None:
+        for name, (msg_type, _) in self.sim.robot.commands.items():
+            if msg_type._type == "geometry_msgs/Twist":
+                self.sim.apply(name, msg_type())
+
+    def _publish_goal(self, x: float, y: float, yaw: float) -> None:
+        goal = PoseStamped(
+            header=Header(stamp=Time.from_sec(self.time_ns / NS), frame_id="map"),
+            pose=Pose(
+                position=Point(x=x, y=y),
+                orientation=Quaternion(z=math.sin(yaw / 2), w=math.cos(yaw / 2)),
+            ),
+        )
+        envelope = Envelope(GOAL_TOPIC, PoseStamped._type, goal.serialize())
+        self.bus.publish(RUN, envelope, self.time_ns / NS)
+        self.recorder.record(GOAL_TOPIC, envelope.type, self.time_ns, envelope.data)
+
+    # ----------------------------------------------------------------------------- simulation
+    def advance_to(self, time_ns: int) -> None:
+        """Step the robot to run time `time_ns`, routing what it publishes."""
+        if time_ns > self.time_ns:
+            try:
+                published = self.sim.step((time_ns - self.time_ns) / NS)
+            except SimulationError as error:
+                raise RunEnd(RunState.FAILED, f"failed: the simulation stopped: {error}") from None
+            self.time_ns = time_ns
+            for item in published:
+                self._from_robot(item.topic, item.message, item.time_s)
+            for event in self.sim.drain_events():
+                if event.kind is EventKind.LEFT_BOUNDS:
+                    log.debug("run %s: robot left the bounds at %.3f s", self.run_id, event.time_s)
+        self._check_robot()
+        if self.time_ns >= self._next_tf_ns:
+            self._record_tf()
+        if self.recorder.error:
+            raise RunEnd(RunState.FAILED, f"failed: {self.recorder.error}")
+
+    def _check_robot(self) -> None:
+        pose = self.sim.state.pose
+        min_x, min_y, max_x, max_y = self.sim.world.bounds
+        margin = MAP_MARGIN_M
+        if not (
+            min_x - margin <= pose.x <= max_x + margin
+            and min_y - margin <= pose.y <= max_y + margin
+        ):
+            raise RunEnd(RunState.FAILED, "failed: robot left the map")
+
+    def _record_tf(self) -> None:
+        pose = self.sim.state.pose
+        message = tf_message(
+            self.time_ns, pose.x, pose.y, pose.yaw, self.sim.robot.sensor_frames(self.sim.state)
+        )
+        self.recorder.record("tf", message._type, self.time_ns, message.serialize())
+        self._next_tf_ns = self.time_ns + TF_PERIOD_NS
+
+    def _collect_logs(self, slot: NodeSlot) -> None:
+        if slot.process is None:
+            return
+        lines = slot.process.logs.take()
+        if lines:
+            slot.logs.extend(lines)
+            if self.recorder is not None:
+                self.recorder.write_log(slot.name, lines)

@@ -1,0 +1,262 @@
+"""Runs through the real sandbox: controllers drive the CrowBot, crashes end runs with a reason,
+nodes talk both ways, lockstep is deterministic, realtime keeps time, the recording holds every
+topic, controls act while running, and a failing run leaves the others alone."""
+
+from __future__ import annotations
+
+import threading
+import time
+
+import pytest
+from mcap.reader import make_reader
+
+from sandbox.protocol import Clock
+from server.runs.run import FaultKind, Run
+from server.runs.spec import NodeSpec, RunSpec, RunSpecError
+from server.runs.state import RunState
+
+STEP_APPROACH = """
+RATE_HZ = 10
+SUBSCRIBE = ["Distance"]
+
+def step(obs):
+    if obs.Distance is None or obs.Distance.data == 0:
+        return (0.0, 0.0)
+    return (0.5 * (obs.Distance.data / 100 - 0.2), 0.0)
+"""
+
+ROSPY_APPROACH = """
+import rospy
+from std_msgs.msg import Int32
+from geometry_msgs.msg import Twist
+
+distance = None
+
+def on_distance(msg):
+    global distance
+    distance = msg.data
+
+rospy.init_node("approach")
+rospy.Subscriber("Distance", Int32, on_distance)
+pub = rospy.Publisher("Control", Twist, queue_size=1)
+rate = rospy.Rate(20)
+while not rospy.is_shutdown():
+    cmd = Twist()
+    if distance:
+        cmd.linear.x = 0.5 * (distance / 100 - 0.2)
+    pub.publish(cmd)
+    rate.sleep()
+"""
+
+
+def crowbot_run(tmp_path, launcher, *nodes: NodeSpec, **options) -> Run:
+    spec = RunSpec(robot="crowbot", world="wall_approach", nodes=tuple(nodes), **options)
+    return Run(spec, launcher, tmp_path / "run")
+
+
+def node(code: str, name: str = "controller") -> NodeSpec:
+    return NodeSpec(name=name, code=code, filename=f"{name}.py")
+
+
+def read_recording(path) -> dict[str, list[tuple[int, bytes]]]:
+    topics: dict[str, list[tuple[int, bytes]]] = {}
+    with open(path, "rb") as f:
+        for _schema, channel, message in make_reader(f).iter_messages():
+            topics.setdefault(channel.topic, []).append((message.log_time, message.data))
+    return topics
+
+
+@pytest.mark.parametrize("code", [STEP_APPROACH, ROSPY_APPROACH], ids=["step", "rospy"])
+def test_a_controller_drives_the_crowbot_to_the_wall(tmp_path, launcher, code):
+    run = crowbot_run(tmp_path, launcher, node(code), duration_s=15.0)
+    result = run.execute()
+    assert result.state is RunState.FINISHED, result.reason
+    assert result.reason == "finished: duration reached"
+    assert result.duration_s == pytest.approx(15.0)
+    # Started with the sensor 0.6 m from the board; held near 0.2 m.
+    assert run.sim.state.pose.x == pytest.approx(1.35 - 0.2, abs=0.03)
+    assert result.metrics["collisions"] == 0
+    period = result.nodes["controller"]["period"]
+    assert period["p50_s"] == pytest.approx(0.1 if "RATE_HZ" in code else 0.05)
+    assert (tmp_path / "run" / "recording.mcap").is_file()
+
+
+def test_a_crashing_node_ends_the_run_with_its_line(tmp_path, launcher):
+    code = "RATE_HZ = 10\n\ndef step(obs):\n    if obs.time > 0.25:\n        return 1 / 0\n"
+    run = crowbot_run(tmp_path, launcher, node(code, "follower"), duration_s=5.0)
+    result = run.execute()
+    assert result.state is RunState.FAILED
+    assert result.reason == "failed: node follower raised ZeroDivisionError at line 5"
+    assert result.duration_s == pytest.approx(0.3)
+    log = (tmp_path / "run" / "logs" / "follower.log").read_text()
+    assert 'File "follower.py", line 5, in step' in log
+    assert "ZeroDivisionError: division by zero" in log
+
+
+TALKER = """
+import rospy
+from std_msgs.msg import Int32
+rospy.init_node("talker")
+heard = []
+rospy.Subscriber("reply", Int32, lambda m: heard.append(m.data))
+pub = rospy.Publisher("ping", Int32, queue_size=10)
+rate = rospy.Rate(10)
+for i in range(5):
+    pub.publish(Int32(i))
+    rate.sleep()
+rate.sleep()
+assert heard == [0, 10, 20, 30, 40], heard
+rospy.loginfo("heard %s", heard)
+"""
+
+ECHO = """
+import rospy
+from std_msgs.msg import Int32
+rospy.init_node("echo")
+pub = rospy.Publisher("reply", Int32, queue_size=10)
+rospy.Subscriber("ping", Int32, lambda m: pub.publish(Int32(m.data * 10)))
+rospy.spin()
+"""
+
+
+def test_two_nodes_pass_messages_both_ways(tmp_path, launcher):
+    run = crowbot_run(
+        tmp_path, launcher, node(TALKER, "talker"), node(ECHO, "echo"), duration_s=3.0
+    )
+    result = run.execute()
+    assert result.state is RunState.FINISHED, (result.reason, list(run.slots["talker"].logs))
+    assert any("heard [0, 10, 20, 30, 40]" in line for line in run.slots["talker"].logs)
+    graph = {t["name"]: t for t in result.graph["topics"]}
+    assert graph["ping"]["publishers"] == ["talker"] and graph["ping"]["subscribers"] == ["echo"]
+    assert graph["reply"]["publishers"] == ["echo"] and graph["reply"]["subscribers"] == ["talker"]
+
+
+def test_lockstep_runs_with_one_seed_record_identical_payloads(tmp_path, launcher):
+    recordings = []
+    for attempt in range(2):
+        spec = RunSpec(
+            robot="crowbot",
+            world="light_arena",
+            nodes=(node("def step(obs):\n    return (0.05, 0.8)\n"),),
+            duration_s=4.0,
+            seed=7,
+        )
+        Run(spec, launcher, tmp_path / f"run{attempt}").execute()
+        recordings.append(read_recording(tmp_path / f"run{attempt}" / "recording.mcap"))
+    assert recordings[0] == recordings[1]
+    assert len(recordings[0]["/Light"]) == 4 * 20 + 1
+
+
+def test_realtime_run_keeps_wall_time(tmp_path, launcher):
+    run = crowbot_run(tmp_path, launcher, node(STEP_APPROACH), duration_s=3.0, clock=Clock.REALTIME)
+    started = time.monotonic()
+    result = run.execute()
+    elapsed = time.monotonic() - started
+    assert result.state is RunState.FINISHED, result.reason
+    assert 3.0 <= elapsed < 4.5  # node start-up from the warm pool plus the 3 s run
+    assert result.nodes["controller"]["period"]["p50_s"] == pytest.approx(0.1, abs=0.01)
+
+
+def test_recording_has_every_declared_topic_with_its_schema(tmp_path, launcher):
+    spec = RunSpec(
+        robot="crop_rover",
+        world="crop_rows",
+        nodes=(node("def step(obs):\n    return (0.1, 0.0)\n"),),
+        duration_s=2.0,
+    )
+    run = Run(spec, launcher, tmp_path / "run")
+    assert run.execute().state is RunState.FINISHED
+    with open(tmp_path / "run" / "recording.mcap", "rb") as f:
+        reader = make_reader(f)
+        summary = reader.get_summary()
+        channels = {c.topic: summary.schemas[c.schema_id] for c in summary.channels.values()}
+    for topic in ("/scan", "/psi", "/imu", "/odom", "/u", "/cmd_vel", "/tf", "/goal"):
+        assert topic in channels, topic
+        assert channels[topic].encoding == "ros1msg"
+    assert channels["/scan"].name == "sensor_msgs/LaserScan"
+    assert b"float32[] ranges" in channels["/scan"].data
+    counts = {
+        topic: len(v) for topic, v in read_recording(tmp_path / "run" / "recording.mcap").items()
+    }
+    assert counts["/scan"] == pytest.approx(2.0 * 7, abs=1)
+    assert counts["/cmd_vel"] == 20
+
+
+def test_controls_stop_pause_button_goal_and_faults(tmp_path, launcher):
+    code = """
+RATE_HZ = 20
+def step(obs):
+    if obs.Button is not None and obs.Button.data:
+        print("button at", round(obs.time, 2))
+    if obs.goal is not None:
+        print("goal", obs.goal.pose.position.x)
+    return None
+"""
+    run = crowbot_run(tmp_path, launcher, node(code), duration_s=600.0)
+    thread = threading.Thread(target=lambda: setattr(run, "result", run.execute()))
+    thread.start()
+    while run.progress[0] < 1.0:
+        time.sleep(0.01)
+    run.pause()
+    time.sleep(0.2)
+    paused_at = run.progress[0]
+    time.sleep(0.3)
+    assert run.progress[0] == paused_at and run.state is RunState.PAUSED
+    run.press_button(True)
+    run.set_goal(1.2, 0.4)
+    run.inject_fault(FaultKind.DROP_TOPIC, "Distance", 1.0)
+    run.resume()
+    time.sleep(0.3)
+    run.stop("stopped by the test")
+    thread.join(timeout=30)
+    result = run.result
+    assert result.state is RunState.INTERRUPTED
+    assert result.reason == "interrupted: stopped by the test"
+    logs = list(run.slots["controller"].logs)
+    assert any(line.startswith("button at") for line in logs)
+    assert "goal 1.2" in logs
+
+
+def test_a_failing_run_leaves_a_concurrent_run_alone(tmp_path, launcher):
+    good = crowbot_run(tmp_path / "a", launcher, node(STEP_APPROACH), duration_s=30.0)
+    results = {}
+    thread = threading.Thread(target=lambda: results.setdefault("good", good.execute()))
+    thread.start()
+    bad = crowbot_run(tmp_path / "b", launcher, node("import os\nos._exit(3)\n"), duration_s=5)
+    assert bad.execute().state is RunState.FAILED
+    thread.join(timeout=60)
+    assert results["good"].state is RunState.FINISHED
+
+
+def test_robot_leaving_the_map_fails_the_run(tmp_path, launcher):
+    spec = RunSpec(
+        robot="crowbot",
+        world="line_track",
+        nodes=(node("def step(obs):\n    return (0.2, 0.0)\n"),),
+        duration_s=60.0,
+    )
+    result = Run(spec, launcher, tmp_path / "run").execute()
+    assert result.state is RunState.FAILED
+    assert result.reason == "failed: robot left the map"
+
+
+@pytest.mark.parametrize(
+    ("changes", "message"),
+    [
+        ({"robot": "crowbotz"}, "valid robot ids: crop_rover, crowbot"),
+        ({"world": "mars"}, "valid world ids: crop_rows"),
+        ({"world": "crop_rows"}, "cannot be placed in world 'crop_rows'"),
+        ({"duration_s": -1}, "positive number of seconds"),
+        ({"duration_s": float("nan")}, "positive number of seconds"),
+        ({"nodes": ()}, "at least one node"),
+    ],
+)
+def test_bad_specs_are_sentences(changes, message):
+    base = {"robot": "crowbot", "world": "wall_approach", "nodes": (node("x = 1\n"),)}
+    with pytest.raises(RunSpecError, match=message):
+        RunSpec(**{**base, **changes}).validate()
+
+
+def test_missing_node_file_is_a_sentence(tmp_path):
+    with pytest.raises(RunSpecError, match="does not exist"):
+        NodeSpec.from_file(tmp_path / "nope.py")
