@@ -1,89 +1,193 @@
 """`robodojo`: the command line.
 
-Until the run engine and the web server land, `robodojo run` drives the simulator with a constant
-velocity command and prints what the robot publishes, like `rostopic echo`:
+    robodojo robots                       # the robots, a line each (--topics for their topics)
+    robodojo worlds                       # the worlds, a line each
+    robodojo run --robot crowbot --world wall_approach --node examples/crowbot/pid_distance.py
+    robodojo export RUN_DIR               # a CSV per topic from a run's recording
 
-    robodojo run --robot crowbot --world wall_approach --linear 0.1 --duration 3 --echo Distance
+`run` executes headless: a progress bar of simulated time on a terminal (plain lines when not a
+TTY), the recording and artifacts written to --out, and one JSON summary as the last line of
+standard output. Exit code 0 when the run finished, 1 when it failed or was interrupted (the
+reason on stderr), 2 for a mistake in the command.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
+import signal
 import sys
+import threading
+import time
+from pathlib import Path
 
-from sandbox.msgs.geometry_msgs import Twist, Vector3
-from server.sim import Simulation, get_robot, load_world, robot_ids, robots_for_world, world_ids
-from server.sim.robots.base import Direction
+from sandbox.bwrap import SandboxUnavailable
+from sandbox.launcher import Launcher
+from sandbox.protocol import Clock
+from server.runs.run import Run
+from server.runs.spec import NodeSpec, RunSpec, RunSpecError
+from server.runs.state import RunState
+from server.sim import get_robot, load_world, robot_ids, robots_for_world, world_ids
+from server.sim.world import WorldError
+
+PROGRESS_WIDTH = 30  # [characters] of the progress bar
 
 
-def _cmd_robots(_: argparse.Namespace) -> int:
+def _cmd_robots(args: argparse.Namespace) -> int:
     for robot_id in robot_ids():
         robot = get_robot(robot_id)
-        print(f"{robot_id}: {robot.title}")
-        print(f"  source: {robot.source}")
-        print(f"  worlds: {', '.join(robots_for_world(robot_id))}")
-        for topic in robot.topics():
-            rate = f" @ {topic.rate_hz:g} Hz" if topic.rate_hz else ""
-            print(
-                f"  {topic.direction:9} {topic.name} [{topic.type_name}]{rate}: {topic.description}"
-            )
+        print(f"{robot_id:<11} {robot.title}  [worlds: {', '.join(robots_for_world(robot_id))}]")
+        if args.topics:
+            for topic in robot.topics():
+                rate = f" @ {topic.rate_hz:g} Hz" if topic.rate_hz else ""
+                print(f"    {topic.direction:<9} {topic.name} [{topic.type_name}]{rate}: "
+                      f"{topic.description}")  # fmt: skip
     return 0
 
 
 def _cmd_worlds(_: argparse.Namespace) -> int:
     for world_id in world_ids():
         world = load_world(world_id)
-        print(f"{world_id}: {world.title} (robots: {', '.join(world.robots)})")
+        print(f"{world_id:<14} {world.title}  [robots: {', '.join(world.robots)}]")
     return 0
 
 
-def _velocity_topic(robot_id: str) -> str:
-    for topic in get_robot(robot_id).topics():
-        if topic.direction is Direction.SUBSCRIBE and topic.msg_type is Twist:
-            return topic.name
-    raise SystemExit(f"robot '{robot_id}' takes no velocity command")
+def _node_specs(values: list[str]) -> tuple[NodeSpec, ...]:
+    """`--node FILE` or `--node NAME=FILE`, as in a launch file."""
+    nodes = []
+    for value in values:
+        name, _, path = value.rpartition("=") if "=" in value else ("", "", value)
+        nodes.append(NodeSpec.from_file(path, name or None))
+    return tuple(nodes)
+
+
+class Progress:
+    """A bar of simulated time on a terminal; a line every 10% otherwise."""
+
+    def __init__(self, run: Run, stream=sys.stderr) -> None:
+        self.run = run
+        self.stream = stream
+        self.tty = stream.isatty()
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._loop, daemon=True)
+        self._last_tenth = -1
+
+    def __enter__(self) -> Progress:
+        self._thread.start()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self._stop.set()
+        self._thread.join()
+        if self.tty:
+            self.stream.write("\n")
+
+    def _loop(self) -> None:
+        while not self._stop.wait(0.1 if self.tty else 0.5):
+            now, total = self.run.progress
+            fraction = min(1.0, now / total) if total else 1.0
+            if self.tty:
+                filled = round(fraction * PROGRESS_WIDTH)
+                bar = "#" * filled + "-" * (PROGRESS_WIDTH - filled)
+                self.stream.write(f"\r[{bar}] {now:7.2f} / {total:g} s  {self.run.state}")
+                self.stream.flush()
+            elif int(fraction * 10) > self._last_tenth:
+                self._last_tenth = int(fraction * 10)
+                self.stream.write(f"progress: {now:.1f} / {total:g} s\n")
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
-    sim = Simulation(args.robot, args.world, seed=args.seed, spawn=args.spawn)
-    sim.apply(
-        _velocity_topic(args.robot),
-        Twist(linear=Vector3(x=args.linear), angular=Vector3(z=args.angular)),
+    spec = RunSpec(
+        robot=args.robot,
+        world=args.world,
+        nodes=_node_specs(args.node),
+        clock=Clock(args.clock),
+        duration_s=args.duration,
+        seed=args.seed,
+        spawn=args.spawn,
     )
-    counts: dict[str, int] = {}
-    steps = max(1, round(args.duration / 0.05))
-    for _ in range(steps):
-        for item in sim.step(0.05):
-            counts[item.topic] = counts.get(item.topic, 0) + 1
-            if item.topic in args.echo:
-                print(f"[{item.time_s:8.3f}] {item.topic}: {item.message}")
-    pose = sim.state.pose
-    print(
-        f"t={sim.time_s:.3f} s  pose=({pose.x:.3f} m, {pose.y:.3f} m, {pose.yaw:.3f} rad)  "
-        f"travelled={sim.state.distance_travelled_m:.3f} m  contacts={sim.state.contact_count}"
+    spec.validate()
+    out_dir = (
+        Path(args.out)
+        if args.out
+        else Path("robodojo-data") / "runs" / time.strftime("%Y%m%d-%H%M%S")
     )
-    for topic, count in sorted(counts.items()):
-        print(f"  {topic}: {count} messages")
+    launcher = Launcher(pool_size=len(spec.nodes), unsafe_no_sandbox=args.unsafe_no_sandbox)
+    try:
+        run = Run(spec, launcher, out_dir)
+        # Ctrl-C ends the run cleanly (nodes shut down, recording closed) instead of killing it.
+        signal.signal(signal.SIGINT, lambda *_: run.stop("interrupted from the keyboard"))
+        with Progress(run):
+            result = run.execute()
+    finally:
+        launcher.close()
+    for name, slot in run.slots.items():
+        if slot.exited is not None and slot.exited.error is not None:
+            print(f"--- node {name} ---", file=sys.stderr)
+            print(slot.exited.error.traceback.rstrip(), file=sys.stderr)
+    if result.state is not RunState.FINISHED:
+        print(f"robodojo: {result.reason}", file=sys.stderr)
+    print(json.dumps(result.summary()))
+    return 0 if result.state is RunState.FINISHED else 1
+
+
+def _cmd_export(args: argparse.Namespace) -> int:
+    from server.runs.export import export_csv
+
+    run_dir = Path(args.run_dir)
+    recording = run_dir / "recording.mcap"
+    if not recording.is_file():
+        raise ValueError(f"'{run_dir}' holds no recording.mcap; give the --out folder of a run")
+    written = export_csv(recording, Path(args.out) if args.out else run_dir / "csv")
+    for path in written:
+        print(path)
     return 0
+
+
+def _positive_seconds(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"'{text}' is not a number of seconds") from None
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"a duration must be positive, got {text}")
+    return value
 
 
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="robodojo", description="RoboDojo remote robot lab")
     commands = parser.add_subparsers(dest="command", required=True)
-    commands.add_parser("robots", help="list robots and their topics").set_defaults(
-        func=_cmd_robots
+    robots = commands.add_parser("robots", help="list the robots")
+    robots.add_argument("--topics", action="store_true", help="also list each robot's topics")
+    robots.set_defaults(func=_cmd_robots)
+    commands.add_parser("worlds", help="list the worlds").set_defaults(func=_cmd_worlds)
+
+    run = commands.add_parser("run", help="run controller nodes against a simulated robot")
+    run.add_argument("--robot", required=True, help=f"one of {', '.join(robot_ids())}")
+    run.add_argument("--world", required=True, help=f"one of {', '.join(world_ids())}")
+    run.add_argument(
+        "--node",
+        action="append",
+        required=True,
+        metavar="[NAME=]FILE",
+        help="a controller file; repeat for several nodes",
     )
-    commands.add_parser("worlds", help="list worlds").set_defaults(func=_cmd_worlds)
-    run = commands.add_parser("run", help="drive a simulated robot with a constant command")
-    run.add_argument("--robot", default="crowbot", help=f"one of {', '.join(robot_ids())}")
-    run.add_argument("--world", default="wall_approach", help=f"one of {', '.join(world_ids())}")
-    run.add_argument("--spawn", default=None, help="named spawn pose in the world")
+    run.add_argument("--duration", type=_positive_seconds, default=30.0, help="seconds")
+    run.add_argument("--clock", choices=[c.value for c in Clock], default=Clock.LOCKSTEP.value)
     run.add_argument("--seed", type=int, default=0)
-    run.add_argument("--duration", type=float, default=5.0, help="simulated seconds")
-    run.add_argument("--linear", type=float, default=0.1, help="linear.x [m/s]")
-    run.add_argument("--angular", type=float, default=0.0, help="angular.z [rad/s]")
-    run.add_argument("--echo", action="append", default=[], help="print a topic's messages")
+    run.add_argument("--spawn", default=None, help="a named start pose of the world")
+    run.add_argument("--out", default=None, help="folder for the recording, logs, artifacts")
+    run.add_argument(
+        "--unsafe-no-sandbox",
+        action="store_true",
+        help="DANGER: run student code without bubblewrap (trusted code on a laptop only)",
+    )
     run.set_defaults(func=_cmd_run)
+
+    export = commands.add_parser("export", help="write a CSV per topic from a run's recording")
+    export.add_argument("run_dir", help="the --out folder of a run")
+    export.add_argument("--out", default=None, help="folder for the CSV files")
+    export.set_defaults(func=_cmd_export)
     return parser
 
 
@@ -91,7 +195,8 @@ def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     try:
         return args.func(args)
-    except ValueError as error:  # our errors are sentences; no traceback for a typo
+    except (RunSpecError, WorldError, SandboxUnavailable, ValueError) as error:
+        # Our errors are sentences: no traceback for a typo.
         print(f"robodojo: {error}", file=sys.stderr)
         return 2
 
