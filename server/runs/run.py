@@ -20,7 +20,6 @@ import time
 import uuid
 from collections import deque
 from dataclasses import dataclass, field
-from enum import StrEnum
 from pathlib import Path
 
 from sandbox.launcher import Launcher
@@ -30,8 +29,10 @@ from sandbox.msgs.std_msgs import Header
 from sandbox.node_process import NodeProcess
 from sandbox.protocol import Clock, Envelope, Exited, NodeInfo, Outcome, RobotTopic, Yield
 from server.runs.bus import ROBOT, RUN, TopicBus
+from server.runs.faults import Fault, FaultKind, Faults
 from server.runs.metrics import NodeMetrics
 from server.runs.recorder import Recorder
+from server.runs.result import RunEnd, RunResult
 from server.runs.spec import NodeSpec, RunSpec
 from server.runs.state import RunState, check_transition
 from server.runs.tf import tf_message
@@ -46,19 +47,6 @@ GOAL_TOPIC = "goal"  # RViz's "2D Nav Goal" idea: the run publishes the goal pos
 TF_PERIOD_NS = NS // 30  # [ns] /tf recorded at 30 Hz: smooth in Foxglove, small on disk
 MAP_MARGIN_M = 0.5  # [m] beyond the world's bounds by this much, the robot left the map
 LOG_LINES_KEPT = 2000  # per node in memory (the recording keeps them all)
-
-
-class FaultKind(StrEnum):
-    DROP_TOPIC = "drop_topic"  # a sensor goes silent
-    FREEZE_TOPIC = "freeze_topic"  # a sensor repeats its last reading
-    STALL_MOTORS = "stall_motors"  # the wheels stop answering commands
-
-
-@dataclass(frozen=True, slots=True)
-class Fault:
-    kind: FaultKind
-    topic: str | None
-    until_ns: int
 
 
 @dataclass
@@ -81,47 +69,6 @@ class NodeSlot:
         return self.spec.name
 
 
-@dataclass
-class RunResult:
-    run_id: str
-    state: RunState
-    reason: str
-    duration_s: float
-    wall_s: float
-    metrics: dict
-    nodes: dict[str, dict]
-    paths: dict[str, str]
-    graph: dict
-
-    def summary(self) -> dict:
-        """The result in one JSON-able dict, without histograms (metrics.json has them)."""
-        return {
-            "run_id": self.run_id,
-            "state": str(self.state),
-            "reason": self.reason,
-            "duration_s": round(self.duration_s, 6),
-            "wall_s": round(self.wall_s, 3),
-            "metrics": self.metrics,
-            "nodes": {name: _without_histograms(node) for name, node in self.nodes.items()},
-            "paths": self.paths,
-        }
-
-
-def _without_histograms(value: object) -> object:
-    if isinstance(value, dict):
-        return {k: _without_histograms(v) for k, v in value.items() if k != "histogram"}
-    return value
-
-
-class RunEnd(Exception):
-    """Raised inside the loop to end the run: the state and the sentence that says why."""
-
-    def __init__(self, state: RunState, reason: str) -> None:
-        super().__init__(reason)
-        self.state = state
-        self.reason = reason
-
-
 class Run:
     def __init__(
         self,
@@ -141,13 +88,12 @@ class Run:
         self.duration_ns = round(spec.duration_s * NS)
         self._controls: queue.SimpleQueue = queue.SimpleQueue()
         self._state_lock = threading.Lock()
-        self.faults: list[Fault] = []
+        self.faults = Faults()
         self.slots = {node.name: NodeSlot(node) for node in spec.nodes}
         self.bus = TopicBus()
         self.sim: Simulation | None = None
         self.recorder: Recorder | None = None
         self._next_tf_ns = 0
-        self._frozen: dict[str, Envelope] = {}
         self._paused_event = threading.Event()
 
     # ----------------------------------------------------------------------------- controls
@@ -214,8 +160,7 @@ class Run:
             self._publish_goal(*value)
         elif action == "fault":
             kind, topic, duration_s = value
-            fault = Fault(kind, topic, self.time_ns + round(duration_s * NS))
-            self.faults.append(fault)
+            self.faults.add(Fault(kind, topic, self.time_ns + round(duration_s * NS)))
             if kind is FaultKind.STALL_MOTORS:
                 self._stall_motors()
 
@@ -434,7 +379,7 @@ class Run:
                 self._command_robot(slot, envelope)
 
     def _command_robot(self, slot: NodeSlot, envelope: Envelope) -> None:
-        if any(f.kind is FaultKind.STALL_MOTORS for f in self.faults):
+        if self.faults.motors_stalled():
             return
         try:
             message = get_message_class(envelope.type).deserialize(envelope.data)
@@ -450,23 +395,13 @@ class Run:
 
     def _from_robot(self, topic: str, message: object, time_s: float) -> None:
         envelope = Envelope(topic, message._type, message.serialize())
-        if self.faults and self._faulted(envelope):
-            return
-        self.bus.publish(ROBOT, self._frozen.get(topic, envelope), time_s)
         self.recorder.record(topic, envelope.type, round(time_s * NS), envelope.data)
-
-    def _faulted(self, envelope: Envelope) -> bool:
-        self.faults = [f for f in self.faults if f.until_ns > self.time_ns]
-        for fault in self.faults:
-            if fault.topic != envelope.topic:
-                continue
-            if fault.kind is FaultKind.DROP_TOPIC:
-                return True
-            if fault.kind is FaultKind.FREEZE_TOPIC:
-                self._frozen.setdefault(envelope.topic, envelope)
-                return False
-        self._frozen.pop(envelope.topic, None)
-        return False
+        if self.faults.active:
+            self.faults.expire(self.time_ns)
+            envelope = self.faults.filter(envelope)
+            if envelope is None:
+                return
+        self.bus.publish(ROBOT, envelope, time_s)
 
     def _stall_motors(self) -> None:
         for name, (msg_type, _) in self.sim.robot.commands.items():
