@@ -94,7 +94,7 @@ class Run:
         self.sim: Simulation | None = None
         self.recorder: Recorder | None = None
         self._next_tf_ns = 0
-        self._paused_event = threading.Event()
+        self.clock_wall_s = 0.0  # wall time the clock ran (node start-up excluded)
 
     # ----------------------------------------------------------------------------- controls
     # Called from other threads; applied by the loop between two steps.
@@ -190,7 +190,11 @@ class Run:
             self._start_nodes()
             self._move(RunState.RUNNING)
             loop = run_lockstep if self.spec.clock is Clock.LOCKSTEP else run_realtime
-            loop(self)
+            self._clock_started = time.monotonic()
+            try:
+                loop(self)
+            finally:
+                self.clock_wall_s = time.monotonic() - self._clock_started
             end_state, reason = RunState.FINISHED, "finished: duration reached"
         except RunEnd as end:
             end_state, reason = end.state, end.reason
@@ -313,6 +317,7 @@ class Run:
             "collisions": state.contact_count if state else 0,
             "distance_travelled_m": state.distance_travelled_m if state else 0.0,
             "time_out_of_bounds_s": state.time_out_of_bounds_s if state else 0.0,
+            "clock_wall_s": self.clock_wall_s,
         }
         nodes = {}
         for slot in self.slots.values():

@@ -149,11 +149,9 @@ def test_lockstep_runs_with_one_seed_record_identical_payloads(tmp_path, launche
 
 def test_realtime_run_keeps_wall_time(tmp_path, launcher):
     run = crowbot_run(tmp_path, launcher, node(STEP_APPROACH), duration_s=3.0, clock=Clock.REALTIME)
-    started = time.monotonic()
     result = run.execute()
-    elapsed = time.monotonic() - started
     assert result.state is RunState.FINISHED, result.reason
-    assert 3.0 <= elapsed < 4.5  # node start-up from the warm pool plus the 3 s run
+    assert 3.0 <= result.metrics["clock_wall_s"] < 3.3  # real-time factor 1
     assert result.nodes["controller"]["period"]["p50_s"] == pytest.approx(0.1, abs=0.01)
 
 
