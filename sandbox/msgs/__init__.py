@@ -11,7 +11,7 @@ Each class is generated from its ``.msg`` definition text (see ``_core.py``)::
 
 from __future__ import annotations
 
-from . import geometry_msgs, nav_msgs, sensor_msgs, std_msgs
+from . import geometry_msgs, nav_msgs, sensor_msgs, std_msgs, tf2_msgs
 from ._core import (
     MESSAGE_TYPES,
     DeserializationError,
@@ -35,4 +35,5 @@ __all__ = [
     "nav_msgs",
     "sensor_msgs",
     "std_msgs",
+    "tf2_msgs",
 ]

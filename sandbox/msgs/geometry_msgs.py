@@ -108,3 +108,33 @@ Twist twist
 # (x, y, z, rotation about X axis, rotation about Y axis, rotation about Z axis)
 float64[36] covariance
 """
+
+
+class Transform(Message):
+    """A rigid transform: translation [m] then rotation (unit quaternion)."""
+
+    _type = "geometry_msgs/Transform"
+    _definition = """
+# This represents the transform between two coordinate frames in free space.
+
+Vector3 translation
+Quaternion rotation
+"""
+
+
+class TransformStamped(Message):
+    """The pose of frame ``child_frame_id`` in frame ``header.frame_id`` (what tf publishes)."""
+
+    _type = "geometry_msgs/TransformStamped"
+    _definition = """
+# This expresses a transform from coordinate frame header.frame_id
+# to the coordinate frame child_frame_id
+#
+# This message is mostly used by the
+# <a href="http://wiki.ros.org/tf">tf</a> package.
+# See its documentation for more information.
+
+Header header
+string child_frame_id # the frame id of the child frame
+Transform transform
+"""

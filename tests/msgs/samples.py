@@ -5,7 +5,16 @@ float32 fields use values exact in single precision so round trips compare equal
 
 from collections.abc import Callable
 
-from sandbox.msgs import Duration, Message, Time, geometry_msgs, nav_msgs, sensor_msgs, std_msgs
+from sandbox.msgs import (
+    Duration,
+    Message,
+    Time,
+    geometry_msgs,
+    nav_msgs,
+    sensor_msgs,
+    std_msgs,
+    tf2_msgs,
+)
 
 
 def header(seq: int = 7) -> std_msgs.Header:
@@ -20,6 +29,16 @@ def _pose(x: float) -> geometry_msgs.Pose:
 
 def _twist() -> geometry_msgs.Twist:
     return geometry_msgs.Twist(geometry_msgs.Vector3(0.3, 0, 0), geometry_msgs.Vector3(0, 0, -1.25))
+
+
+def _transform_stamped(child: str, x: float) -> geometry_msgs.TransformStamped:
+    return geometry_msgs.TransformStamped(
+        header(),
+        child,
+        geometry_msgs.Transform(
+            geometry_msgs.Vector3(x, 0.5, 0.0), geometry_msgs.Quaternion(0.0, 0.0, 0.6, 0.8)
+        ),
+    )
 
 
 def _layout() -> std_msgs.MultiArrayLayout:
@@ -60,6 +79,13 @@ SAMPLES: dict[str, Callable[[], Message]] = {
     "geometry_msgs/Twist": _twist,
     "geometry_msgs/TwistWithCovariance": lambda: geometry_msgs.TwistWithCovariance(
         _twist(), [0.01 * i for i in range(36)]
+    ),
+    "geometry_msgs/Transform": lambda: geometry_msgs.Transform(
+        geometry_msgs.Vector3(1.0, -2.0, 0.25), geometry_msgs.Quaternion(0.0, 0.0, 0.6, 0.8)
+    ),
+    "geometry_msgs/TransformStamped": lambda: _transform_stamped("laser", 0.125),
+    "tf2_msgs/TFMessage": lambda: tf2_msgs.TFMessage(
+        [_transform_stamped("base_link", 1.5), _transform_stamped("läser ✓", -0.25)]
     ),
     "sensor_msgs/LaserScan": lambda: sensor_msgs.LaserScan(
         header=header(),

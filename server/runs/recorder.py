@@ -1,0 +1,479 @@
+"""The recording of one run: every topic in an MCAP file, plus the nodes' logs, their artifacts
+and JSON documents such as the metrics.
+
+Layout of ``out_dir``::
+
+    recording.mcap               every message, ROS1-encoded, one channel per topic ("/scan")
+    logs/<node>.log              what each node printed, appended as it arrives
+    artifacts/<node>/<name>      files a node saved
+    <name>.json                  write_json("metrics", ...) -> metrics.json
+
+The MCAP file uses the ``ros1`` profile: each schema has encoding ``ros1msg``, the type name as
+its name and genmsg's full concatenated definition as its data, and each channel has message
+encoding ``ros1``, so Foxglove decodes the messages without knowing our types. A metadata record
+named ``run`` carries the run id and whatever run information the caller passes.
+
+Off the hot path: ``record()`` appends a tuple to an in-memory list under a lock and returns
+(about a microsecond); a writer thread swaps the list out in batches and writes it (schemas,
+channels, chunk compression, disk). Log lines travel the same way.
+
+Backpressure, not loss: the bytes waiting to be written (payloads plus a fixed per-message
+overhead, including the batch the writer is busy with) are bounded by ``max_buffer_bytes``.
+When the writer falls that far behind, ``record()`` blocks until it has caught up. A run then
+slows down instead of eating memory or silently dropping messages; in lockstep that only
+stretches wall time, in realtime it shows as latency, which is honest about a disk that cannot
+keep up.
+
+Failure is contained: an error while writing (disk full, a file that cannot be created, bad
+data) never raises into the caller. The recorder turns ``FAILED``, says why in ``error``
+("recording failed: [Errno 28] No space left on device"), drops what is buffered and makes
+``record()`` a cheap no-op; ``close()`` still returns.
+
+Lifecycle (checked): RECORDING -> CLOSED on ``close()``, RECORDING -> FAILED on a write error
+(final; ``close()`` keeps it). ``record()`` after ``close()`` is a programming error and raises;
+``write_artifacts``/``write_json`` are synchronous, meant for the end of a run, before
+``close()``.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import importlib.util
+import json
+import logging
+import math
+import os
+import re
+import threading
+from collections.abc import Iterable, Mapping
+from enum import StrEnum
+from pathlib import Path
+from typing import IO, Any
+
+from mcap.writer import CompressionType, Writer
+
+from sandbox.msgs import Message, get_message_class
+
+log = logging.getLogger(__name__)
+
+RECORDING_FILE = "recording.mcap"
+LOGS_DIR = "logs"
+ARTIFACTS_DIR = "artifacts"
+
+# Limits: value [unit] and why.
+DEFAULT_MAX_BUFFER_BYTES = 64 * 1024 * 1024  # [B] ~35k LiDAR scans: only a stalled disk gets here
+_ENTRY_OVERHEAD_BYTES = 128  # [B] a tuple + int + topic ref in CPython; bounds tiny messages too
+_WRITER_WAKE_BYTES = 1024 * 1024  # [B] wake the writer early once this much waits (one chunk)
+_WRITER_POLL_S = 0.05  # [s] otherwise the writer drains what has gathered every 50 ms
+_CLOSE_TIMEOUT_S = 60.0  # [s] a writer that cannot finish in this long is declared failed
+_MAX_NAME_CHARS = 100  # [chars] per path component of a log or artifact name
+_MAX_ARTIFACT_DEPTH = 8  # [dirs] sub-directories kept from an artifact name
+
+_UNSAFE_CHARS = re.compile(r"[^\w.\-]+")
+
+
+class RecorderState(StrEnum):
+    RECORDING = "recording"
+    CLOSED = "closed"
+    FAILED = "failed"
+
+
+class RecorderClosedError(RuntimeError):
+    """The recorder was used after ``close()``."""
+
+
+def mcap_topic(name: str) -> str:
+    """The MCAP/ROS topic name of a bus topic: ``scan`` -> ``/scan`` (ROS tools expect the
+    leading slash)."""
+    return name if name.startswith("/") else "/" + name
+
+
+def _path_parts(name: str) -> list[str]:
+    """The parts of `name` split at "/" and "\\", without empty, "." and ".." parts."""
+    return [part for part in re.split(r"[/\\]+", str(name)) if part not in ("", ".", "..")]
+
+
+def safe_name(name: str) -> str:
+    """One path component made from `name`: "." and ".." parts are dropped, separators and
+    other unsafe characters become "_", leading/trailing dots go; never empty."""
+    parts = _path_parts(name)
+    cleaned = _UNSAFE_CHARS.sub("_", "_".join(parts)).strip(".")
+    return cleaned[:_MAX_NAME_CHARS] or "_"
+
+
+def safe_relative_path(name: str) -> Path:
+    """A relative path made from an artifact name: sub-directories are kept, but "..", ".",
+    empty parts and a leading "/" are dropped, so 'a/../../b' -> 'a/b', '/etc/x' -> 'etc/x'."""
+    parts = _path_parts(name)
+    if not parts:
+        return Path("_")
+    kept = parts[-(_MAX_ARTIFACT_DEPTH + 1) :]
+    return Path(*(safe_name(part) for part in kept))
+
+
+def _inside(root: Path, relative: Path) -> Path:
+    """`root / relative`, checked to resolve inside `root` (symlinks included)."""
+    target = root / relative
+    if not target.resolve().is_relative_to(root.resolve()):
+        raise ValueError(f"refusing to write {relative}: it resolves outside {root}")
+    return target
+
+
+def _json_safe(value: Any) -> Any:
+    """Non-finite floats become null: JSON has no NaN or Infinity."""
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if isinstance(value, Mapping):
+        return {str(key): _json_safe(item) for key, item in value.items()}
+    if isinstance(value, list | tuple):
+        return [_json_safe(item) for item in value]
+    return value
+
+
+def _describe(error: BaseException) -> str:
+    if isinstance(error, OSError):
+        return str(error)
+    kind = type(error)
+    name = kind.__name__ if kind.__module__ == "builtins" else f"{kind.__module__}.{kind.__name__}"
+    return f"{name}: {error}"
+
+
+def _default_compression() -> CompressionType:
+    if importlib.util.find_spec("zstandard") is not None:
+        return CompressionType.ZSTD
+    return CompressionType.NONE
+
+
+class Recorder:
+    """Writes one run's recording into `out_dir`; see the module docstring for the contract.
+
+    `metadata` (str -> str) goes into the MCAP ``run`` metadata record next to the run id.
+    """
+
+    def __init__(
+        self,
+        out_dir: Path,
+        run_id: str,
+        *,
+        metadata: Mapping[str, str] | None = None,
+        max_buffer_bytes: int = DEFAULT_MAX_BUFFER_BYTES,
+        compression: CompressionType | None = None,
+    ) -> None:
+        if not isinstance(max_buffer_bytes, int) or max_buffer_bytes <= 0:
+            raise ValueError(f"max_buffer_bytes must be a positive int, got {max_buffer_bytes!r}")
+        run_metadata = {"run_id": str(run_id)}
+        for key, value in (metadata or {}).items():
+            if not isinstance(key, str) or not isinstance(value, str):
+                raise TypeError(f"metadata must map str to str; {key!r}: {value!r} is not")
+            run_metadata[key] = value
+        self.out_dir = Path(out_dir)
+        self.run_id = str(run_id)
+        self.recording_path = self.out_dir / RECORDING_FILE
+        self.max_buffer_bytes = max_buffer_bytes
+        self._wake_bytes = min(_WRITER_WAKE_BYTES, max(1, max_buffer_bytes // 2))
+        self._lock = threading.Lock()
+        self._changed = threading.Condition(self._lock)
+        # Shared with the writer thread, guarded by _lock.
+        self._buffer: list[tuple[str, int, bytes]] = []
+        self._buffered_bytes = 0
+        self._pending_topics: list[tuple[str, type[Message]]] = []
+        self._pending_logs: dict[str, list[str]] = {}
+        self._accepting = True
+        self._state = RecorderState.RECORDING
+        self.error: str | None = None
+        # Caller side.
+        self._topic_types: dict[str, str] = {}
+        self._paths: dict[str, str] = {}
+        self._closed_paths: dict[str, str] | None = None
+        # Writer side.
+        self._channels: dict[str, int] = {}
+        self._channels_by_mcap_topic: dict[str, int] = {}
+        self._schemas: dict[str, int] = {}
+        self._log_files: dict[str, IO[str]] = {}
+        self._file: IO[bytes] | None = None
+        self._writer: Writer | None = None
+        self._thread: threading.Thread | None = None
+        try:
+            self.out_dir.mkdir(parents=True, exist_ok=True)
+            self._file = open(self.recording_path, "wb")  # noqa: SIM115  # closed by the writer
+            self._writer = Writer(self._file, compression=compression or _default_compression())
+            self._writer.start(profile="ros1")
+            self._writer.add_metadata("run", run_metadata)
+        except Exception as error:  # a recorder never raises a write error
+            self._fail(error)
+            self._close_files()
+            return
+        self._thread = threading.Thread(
+            target=self._write_loop, name=f"recorder-{self.run_id}", daemon=True
+        )
+        self._thread.start()
+
+    # ----------------------------------------------------------------------------- state
+    @property
+    def state(self) -> RecorderState:
+        return self._state
+
+    def _fail(self, error: BaseException) -> None:
+        """Enter FAILED with a sentence; the writer thread notices and closes its files."""
+        message = f"recording failed: {_describe(error)}"
+        with self._lock:
+            if self.error is None:
+                self.error = message
+            self._state = RecorderState.FAILED
+            self._accepting = False
+            self._buffer = []
+            self._buffered_bytes = 0
+            self._pending_logs = {}
+            self._changed.notify_all()
+        log.warning("run %s: %s", self.run_id, message)
+
+    def _close_files(self) -> None:
+        for handle in [*self._log_files.values(), self._file]:
+            if handle is not None:
+                with contextlib.suppress(OSError):
+                    handle.close()
+        self._log_files = {}
+
+    def _check_open(self, what: str) -> bool:
+        """True to go ahead; False after a failure (no-op); raises after close()."""
+        if self._state is RecorderState.FAILED:
+            return False
+        if self._closed_paths is not None:
+            raise RecorderClosedError(f"{what} after close(): the recording is already finished")
+        return True
+
+    # ----------------------------------------------------------------------------- topics
+    def add_topic(self, name: str, type_name: str) -> None:
+        """Declare a topic so its channel exists even before (or without) a message.
+
+        Idempotent; a second type on the same topic is refused, as ROS refuses it."""
+        if not isinstance(name, str) or not name.strip("/"):
+            raise ValueError(f"topic name must be a non-empty string, got {name!r}")
+        cls = get_message_class(type_name)  # unknown type: a sentence listing the known ones
+        if not self._check_open("add_topic()"):
+            return
+        topic = mcap_topic(name)
+        with self._lock:
+            for known_name, known_type in self._topic_types.items():
+                if mcap_topic(known_name) == topic and known_type != type_name:
+                    raise ValueError(
+                        f"topic '{topic}' is recorded as {known_type}; it cannot carry "
+                        f"{type_name} too (use another topic name)"
+                    )
+            if name not in self._topic_types:
+                self._topic_types[name] = type_name
+                self._pending_topics.append((name, cls))
+
+    # ----------------------------------------------------------------------------- hot path
+    def record(self, topic: str, type_name: str, log_time_ns: int, data: bytes) -> None:
+        """Queue one ROS1-serialized message published at run time `log_time_ns` [ns].
+
+        Returns at once unless the writer is `max_buffer_bytes` behind (then it waits); a no-op
+        once the recorder has failed."""
+        if self._state is RecorderState.FAILED:
+            return
+        if self._topic_types.get(topic) != type_name:
+            self.add_topic(topic, type_name)
+        if type(data) is not bytes:
+            raise TypeError(f"record() needs the serialized bytes, got {type(data).__name__}")
+        size = len(data) + _ENTRY_OVERHEAD_BYTES
+        with self._lock:
+            if not self._accepting:
+                if self._state is RecorderState.FAILED:
+                    return
+                raise RecorderClosedError("record() after close(): the recording is finished")
+            if self._buffered_bytes and self._buffered_bytes + size > self.max_buffer_bytes:
+                self._wait_for_room(size)
+                if not self._accepting:
+                    return  # failed or closed while we waited
+            self._buffer.append((topic, log_time_ns, data))
+            self._buffered_bytes += size
+            if self._buffered_bytes >= self._wake_bytes:
+                self._changed.notify_all()
+
+    def _wait_for_room(self, size: int) -> None:
+        """Backpressure (lock held): block until the writer has made room for `size` bytes. A
+        message larger than the whole budget waits for an empty buffer, then goes in alone."""
+        self._changed.notify_all()
+        while (
+            self._accepting
+            and self._buffered_bytes
+            and self._buffered_bytes + size > self.max_buffer_bytes
+        ):
+            self._changed.wait()
+
+    def record_message(self, topic: str, log_time_ns: int, message: Message) -> None:
+        """``record()`` for a message object (serialized here, on the caller's thread)."""
+        if self._state is RecorderState.FAILED:
+            return
+        self.record(topic, message._type, log_time_ns, message.serialize())
+
+    def write_log(self, node: str, lines: Iterable[str]) -> None:
+        """Append `lines` (without or with a trailing newline) to ``logs/<node>.log``; written by
+        the writer thread like the messages."""
+        if not self._check_open("write_log()"):
+            return
+        texts = [line if line.endswith("\n") else line + "\n" for line in lines]
+        size = sum(len(text) for text in texts) + _ENTRY_OVERHEAD_BYTES
+        with self._lock:
+            if not self._accepting:
+                return
+            if self._buffered_bytes and self._buffered_bytes + size > self.max_buffer_bytes:
+                self._wait_for_room(size)
+                if not self._accepting:
+                    return
+            self._pending_logs.setdefault(safe_name(node), []).extend(texts)
+            self._buffered_bytes += size
+
+    # ----------------------------------------------------------------------------- end of run
+    def write_artifacts(self, node: str, artifacts: Iterable[tuple[str, bytes]]) -> list[Path]:
+        """Write files a node saved to ``artifacts/<node>/<name>`` (names sanitized: they stay
+        inside ``out_dir`` whatever they contain). Synchronous: call it at the end of a run."""
+        if not self._check_open("write_artifacts()"):
+            return []
+        files = []
+        for name, data in artifacts:
+            if not isinstance(data, bytes | bytearray | memoryview):
+                raise TypeError(f"artifact {name!r} must be bytes, got {type(data).__name__}")
+            files.append((str(name), bytes(data)))
+        root = self.out_dir / ARTIFACTS_DIR
+        written = []
+        try:
+            node_dir = _inside(root, Path(safe_name(node)))
+            for name, data in files:
+                target = _inside(node_dir, safe_relative_path(name))
+                target.parent.mkdir(parents=True, exist_ok=True)
+                target.write_bytes(data)
+                written.append(target)
+        except (OSError, ValueError) as error:  # a recorder never raises a write error
+            self._fail(error)
+            return written
+        if written:
+            self._paths["artifacts"] = str(root)
+        return written
+
+    def write_json(self, name: str, document: Any) -> Path | None:
+        """Write `document` to ``<name>.json`` (e.g. "metrics"), replacing it atomically; NaN
+        and infinities become null. Synchronous: call it at the end of a run."""
+        if not self._check_open("write_json()"):
+            return None
+        stem = safe_name(name.removesuffix(".json"))
+        target = self.out_dir / f"{stem}.json"
+        temporary = self.out_dir / f".{stem}.json.tmp"
+        try:
+            text = json.dumps(_json_safe(document), indent=2, allow_nan=False, default=str)
+            temporary.write_text(text + "\n", encoding="utf-8")
+            os.replace(temporary, target)
+        except Exception as error:  # a recorder never raises a write error
+            self._fail(error)
+            return None
+        self._paths[stem] = str(target)
+        return target
+
+    def close(self, timeout_s: float = _CLOSE_TIMEOUT_S) -> dict[str, str]:
+        """Flush everything, finish the MCAP file and return the paths written ("recording",
+        "logs", "artifacts", one per JSON document). Safe to call twice; never raises a write
+        error (see ``error``)."""
+        if self._closed_paths is not None:
+            return dict(self._closed_paths)
+        with self._lock:
+            self._accepting = False
+            self._changed.notify_all()
+        if self._thread is not None:
+            self._thread.join(timeout_s)
+            if self._thread.is_alive():
+                self._fail(TimeoutError(f"the writer did not finish within {timeout_s:g} s"))
+        if self._state is not RecorderState.FAILED:
+            self._state = RecorderState.CLOSED
+            self._paths = {"recording": str(self.recording_path), **self._paths}
+        self._closed_paths = dict(self._paths)
+        return dict(self._closed_paths)
+
+    def __enter__(self) -> Recorder:
+        return self
+
+    def __exit__(self, *exc_info: object) -> None:
+        self.close()
+
+    # ----------------------------------------------------------------------------- writer
+    def _write_loop(self) -> None:
+        try:
+            while True:
+                with self._lock:
+                    if self._accepting and self._buffered_bytes < self._wake_bytes:
+                        self._changed.wait(_WRITER_POLL_S)
+                    if self._state is RecorderState.FAILED:
+                        return
+                    batch, self._buffer = self._buffer, []
+                    topics, self._pending_topics = self._pending_topics, []
+                    logs, self._pending_logs = self._pending_logs, {}
+                    taken_bytes = self._buffered_bytes
+                    last_pass = not self._accepting
+                self._write_topics(topics)
+                self._write_batch(batch)
+                self._write_logs(logs)
+                with self._lock:
+                    # Counted until written, so the bound covers the batch in flight too.
+                    self._buffered_bytes = max(0, self._buffered_bytes - taken_bytes)
+                    self._changed.notify_all()
+                if last_pass:
+                    break
+            assert self._writer is not None
+            self._writer.finish()
+        except Exception as error:  # contained: the run goes on without us
+            self._fail(error)
+        finally:
+            self._close_files()
+
+    def _write_topics(self, topics: list[tuple[str, type[Message]]]) -> None:
+        writer = self._writer
+        assert writer is not None
+        for name, cls in topics:
+            topic = mcap_topic(name)
+            channel_id = self._channels_by_mcap_topic.get(topic)
+            if channel_id is None:
+                schema_id = self._schemas.get(cls._type)
+                if schema_id is None:
+                    schema_id = writer.register_schema(
+                        name=cls._type, encoding="ros1msg", data=cls._full_text.encode()
+                    )
+                    self._schemas[cls._type] = schema_id
+                channel_id = writer.register_channel(
+                    topic=topic,
+                    message_encoding="ros1",
+                    schema_id=schema_id,
+                    metadata={"md5sum": cls._md5sum},
+                )
+                self._channels_by_mcap_topic[topic] = channel_id
+            self._channels[name] = channel_id
+
+    def _write_batch(self, batch: list[tuple[str, int, bytes]]) -> None:
+        """Write queued messages in the order they were recorded (overridable in tests)."""
+        writer = self._writer
+        assert writer is not None
+        channels = self._channels
+        for topic, log_time_ns, data in batch:
+            writer.add_message(
+                channel_id=channels[topic],
+                log_time=log_time_ns,
+                publish_time=log_time_ns,
+                data=data,
+            )
+        if batch:
+            assert self._file is not None
+            self._file.flush()
+
+    def _write_logs(self, logs: dict[str, list[str]]) -> None:
+        if not logs:
+            return
+        logs_dir = self.out_dir / LOGS_DIR
+        for node, texts in logs.items():
+            handle = self._log_files.get(node)
+            if handle is None:
+                logs_dir.mkdir(parents=True, exist_ok=True)
+                path = _inside(logs_dir, Path(f"{node}.log"))
+                handle = open(path, "a", encoding="utf-8")  # noqa: SIM115  # closed at the end
+                self._log_files[node] = handle
+                self._paths["logs"] = str(logs_dir)
+            handle.writelines(texts)
+            handle.flush()
