@@ -210,7 +210,18 @@ class Run:
         spawn = Pose2D(*spec.initial_pose) if spec.initial_pose else spec.spawn
         self.sim = Simulation(spec.robot, spec.world, seed=spec.seed, spawn=spawn)
         self.out_dir.mkdir(parents=True, exist_ok=True)
-        self.recorder = Recorder(self.out_dir, self.run_id)
+        self.recorder = Recorder(
+            self.out_dir,
+            self.run_id,
+            metadata={
+                "robot": spec.robot,
+                "world": spec.world,
+                "clock": str(spec.clock),
+                "seed": str(spec.seed),
+                "duration_s": str(spec.duration_s),
+                "nodes": ",".join(node.name for node in spec.nodes),
+            },
+        )
         for topic in self.sim.topics:
             self.bus.declare_topic(topic.name, topic.type_name, ROBOT if topic.rate_hz else None)
             self.recorder.add_topic(topic.name, topic.type_name)
@@ -457,8 +468,14 @@ class Run:
 
     def _record_tf(self) -> None:
         pose = self.sim.state.pose
+        origin = self.sim.odometry_origin
         message = tf_message(
-            self.time_ns, pose.x, pose.y, pose.yaw, self.sim.robot.sensor_frames(self.sim.state)
+            self.time_ns,
+            pose.x,
+            pose.y,
+            pose.yaw,
+            self.sim.robot.sensor_frames(self.sim.state),
+            odom_origin=(origin.x, origin.y, origin.yaw),
         )
         self.recorder.record("tf", message._type, self.time_ns, message.serialize())
         self._next_tf_ns = self.time_ns + TF_PERIOD_NS

@@ -190,6 +190,11 @@ class Simulation:
 
     # ----------------------------------------------------------------------------- topics
     @property
+    def odometry_origin(self) -> Pose2D:
+        """Where the odometry frame starts: the world pose the robot was reset to."""
+        return self._odom_origin
+
+    @property
     def time_s(self) -> float:
         return self._now_ns / NS_PER_S
 
