@@ -30,14 +30,18 @@ CROWBOT_TOPICS = [
 ]
 
 
-def crowbot_info(name: str = "node", clock: Clock = Clock.LOCKSTEP) -> NodeInfo:
-    return NodeInfo(
-        node_name=name,
-        robot="crowbot",
-        robot_topics=CROWBOT_TOPICS,
-        velocity_topic="Control",
-        clock=clock,
-    )
+def crowbot_info(name: str = "node", **overrides: object) -> NodeInfo:
+    """What a CrowBot node called `name` is told about its run; `overrides` replace any other
+    field (clock, params, allow_new_topics, ...)."""
+    fields: dict[str, object] = {
+        "node_name": name,
+        "robot": "crowbot",
+        "robot_topics": CROWBOT_TOPICS,
+        "velocity_topic": "Control",
+        "clock": Clock.LOCKSTEP,
+    }
+    fields.update(overrides)
+    return NodeInfo(**fields)  # type: ignore[arg-type]
 
 
 @pytest.fixture(scope="module")

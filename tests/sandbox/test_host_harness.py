@@ -20,44 +20,21 @@ from sandbox.limits import DEFAULT_LIMITS, Limits
 from sandbox.msgs import Message
 from sandbox.protocol import (
     Api,
-    Clock,
     Envelope,
     Exited,
     Load,
     NodeInfo,
     Outcome,
     ProtocolError,
-    RobotTopic,
     Shutdown,
     ToChild,
     ToParent,
     Wake,
     Yield,
 )
+from tests.sandbox.conftest import crowbot_info
 
 TIMEOUT_S = 20.0  # [s] generous wall-clock bound on any single frame, so a bug fails, not hangs
-
-CROWBOT_TOPICS = [
-    RobotTopic("Distance", "std_msgs/Int32", "publish", 20.0),
-    RobotTopic("Button", "std_msgs/Bool", "publish", 20.0),
-    RobotTopic("Light", "std_msgs/Int32MultiArray", "publish", 20.0),
-    RobotTopic("Line", "std_msgs/Int32MultiArray", "publish", 20.0),
-    RobotTopic("Control", "geometry_msgs/Twist", "subscribe"),
-    RobotTopic("Leds", "std_msgs/Int32MultiArray", "subscribe"),
-    RobotTopic("Buzzer", "std_msgs/Bool", "subscribe"),
-]
-
-
-def crowbot_info(**overrides: object) -> NodeInfo:
-    fields: dict[str, object] = {
-        "node_name": "student",
-        "robot": "crowbot",
-        "robot_topics": CROWBOT_TOPICS,
-        "velocity_topic": "Control",
-        "clock": Clock.LOCKSTEP,
-    }
-    fields.update(overrides)
-    return NodeInfo(**fields)  # type: ignore[arg-type]
 
 
 def envelope(topic: str, message: Message) -> Envelope:
@@ -103,7 +80,7 @@ class Parent:
         self._decoder = msgspec.msgpack.Decoder(ToParent)
         self._encoder = msgspec.msgpack.Encoder()
         self.crash: BaseException | None = None
-        load = Load(textwrap.dedent(code), filename, api, info or crowbot_info())
+        load = Load(textwrap.dedent(code), filename, api, info or crowbot_info("student"))
 
         def child() -> None:
             try:

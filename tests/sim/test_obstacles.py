@@ -9,39 +9,10 @@ import numpy as np
 import pytest
 
 from server.sim.obstacles import Obstacles, RayHits
-from server.sim.world import Spawn, World, load_world
+from server.sim.world import load_world
+from tests.sim.shapes import make_world
 
 SCAN = np.linspace(-math.pi, math.pi, 429, endpoint=False)  # a 360-degree LiDAR's beams
-
-
-def make_world(
-    segments: list[tuple[float, float, float, float]] = (),
-    segment_height: float | list[float] = 2.0,
-    circles: list[tuple[float, float, float]] = (),
-    circle_height: float = 1.0,
-) -> World:
-    """A small world built directly from shapes (no world files)."""
-    segment_array = np.asarray(segments, dtype=np.float64).reshape(-1, 4)
-    circle_array = np.asarray(circles, dtype=np.float64).reshape(-1, 3)
-    return World(
-        id="test",
-        title="test",
-        description="",
-        segments=segment_array,
-        segment_height=np.broadcast_to(segment_height, len(segment_array)).astype(float),
-        circles=circle_array,
-        circle_height=np.full(len(circle_array), circle_height),
-        tape_segments=np.zeros((0, 4)),
-        tape_width=np.zeros(0),
-        tape_darkness=np.zeros(0),
-        lights=(),
-        spawns=(Spawn(name="start", x=0.0, y=0.0, yaw=0.0),),
-        bounds=(-20.0, -20.0, 20.0, 20.0),
-        ambient_light=0.1,
-        floor_reflectance=0.5,
-        grid_map=None,
-        robots=(),
-    )
 
 
 def cast_both_ways(

@@ -8,53 +8,10 @@ import numpy as np
 import pytest
 
 from sandbox.msgs.sensor_msgs import Range
-from server.sim.obstacles import Obstacles
-from server.sim.sensors.base import SenseContext
 from server.sim.sensors.ultrasonic_ring import RingRanger, UltrasonicRing
 from server.sim.state import Pose2D, RobotState
-from server.sim.world import Spawn, World
-
-
-def make_world(
-    segments: list[tuple[float, float, float, float]] = (),
-    segment_height: float = 2.0,
-    circles: list[tuple[float, float, float]] = (),
-    circle_height: float = 1.0,
-) -> World:
-    """A small world built directly from shapes (no world files)."""
-    segment_array = np.asarray(segments, dtype=np.float64).reshape(-1, 4)
-    circle_array = np.asarray(circles, dtype=np.float64).reshape(-1, 3)
-    return World(
-        id="test",
-        title="test",
-        description="",
-        segments=segment_array,
-        segment_height=np.full(len(segment_array), segment_height),
-        circles=circle_array,
-        circle_height=np.full(len(circle_array), circle_height),
-        tape_segments=np.zeros((0, 4)),
-        tape_width=np.zeros(0),
-        tape_darkness=np.zeros(0),
-        lights=(),
-        spawns=(Spawn(name="start", x=0.0, y=0.0, yaw=0.0),),
-        bounds=(-20.0, -20.0, 20.0, 20.0),
-        ambient_light=0.1,
-        floor_reflectance=0.5,
-        grid_map=None,
-        robots=(),
-    )
-
-
-def make_context(
-    world: World, state: RobotState | None = None, time_s: float = 0.0
-) -> SenseContext:
-    return SenseContext(
-        world=world,
-        obstacles=Obstacles(world),
-        state=state if state is not None else RobotState(),
-        time_s=time_s,
-        lights=(),
-    )
+from server.sim.world import World
+from tests.sim.shapes import make_context, make_world
 
 
 def front_ranger(ring: UltrasonicRing | None = None) -> RingRanger:
