@@ -33,6 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from server.sim.geometry import distance_to_nearest, offsets_from_segments, segment_arrays
 from server.sim.world import World
 
 _PARALLEL_EPS = 1e-12  # [m^2] |cross(d, e)| below this: ray parallel to the segment, no hit
@@ -96,10 +97,8 @@ class Obstacles:
     def __init__(self, world: World) -> None:
         segments = np.asarray(world.segments, dtype=np.float64).reshape(-1, 4)
         circles = np.asarray(world.circles, dtype=np.float64).reshape(-1, 3)
-        self.segment_start = segments[:, 0:2]
-        self.segment_vector = segments[:, 2:4] - segments[:, 0:2]
+        self.segment_start, self.segment_vector, self.segment_length_sq = segment_arrays(segments)
         lengths = np.hypot(self.segment_vector[:, 0], self.segment_vector[:, 1])
-        self.segment_length_sq = np.maximum(lengths**2, 1e-18)
         # Unit normals; the sign does not matter because incidence uses |cos|.
         self.segment_normal = (
             np.stack([-self.segment_vector[:, 1], self.segment_vector[:, 0]], axis=1)
@@ -179,7 +178,7 @@ class Obstacles:
         """(t, ray, segment index) of every ray-segment hit among the culled pairs."""
         seg = np.flatnonzero(self.segment_height >= min_height_m)
         if seg.size and np.isfinite(reach_m):
-            seg = seg[np.hypot(*self._offsets_from_segments(origin, seg).T) <= reach_m]
+            seg = seg[self._away_from_segments(origin, seg)[1] <= reach_m]
         if not seg.size:
             return _NO_HITS
         wx, wy = self._start_x[seg] - origin[0], self._start_y[seg] - origin[1]
@@ -347,8 +346,7 @@ class Obstacles:
         """
         centre = np.array([centre_x, centre_y])
         pushes: list[np.ndarray] = []
-        away = self._offsets_from_segments(centre)
-        gap = np.hypot(away[:, 0], away[:, 1])
+        away, gap = self._away_from_segments(centre)
         touching = gap < radius_m
         if touching.any():
             g = np.maximum(gap[touching], 1e-9)
@@ -368,24 +366,21 @@ class Obstacles:
 
     def clearance(self, x: float, y: float) -> float:
         """Distance [m] from the point (x, y) to the nearest surface (inf in an empty world)."""
-        point = np.array([x, y])
-        nearest = np.inf
-        if len(self.segment_start):
-            away = self._offsets_from_segments(point)
-            nearest = float(np.min(np.hypot(away[:, 0], away[:, 1])))
-        if len(self.circle_centre):
-            away_c = point - self.circle_centre
-            gaps = np.hypot(away_c[:, 0], away_c[:, 1]) - self.circle_radius
-            nearest = min(nearest, float(np.min(gaps)))
-        return nearest
+        return distance_to_nearest(
+            np.array([x, y]),
+            (self.segment_start, self.segment_vector, self.segment_length_sq),
+            self.circle_centre,
+            self.circle_radius,
+        )
 
-    def _offsets_from_segments(
-        self, point: np.ndarray, index: np.ndarray | None = None
-    ) -> np.ndarray:
+    def _away_from_segments(
+        self, point: np.ndarray, index: np.ndarray | slice = slice(None)
+    ) -> tuple[np.ndarray, np.ndarray]:
         """(N, 2) vectors from the closest point of each segment (or of segments `index`) to
-        `point`."""
-        chosen = slice(None) if index is None else index
-        start, edge = self.segment_start[chosen], self.segment_vector[chosen]
-        rel = point - start
-        along = np.clip(np.sum(rel * edge, axis=1) / self.segment_length_sq[chosen], 0.0, 1.0)
-        return point - (start + along[:, None] * edge)
+        `point`, and their lengths (N,) [m]."""
+        return offsets_from_segments(
+            point,
+            self.segment_start[index],
+            self.segment_vector[index],
+            self.segment_length_sq[index],
+        )

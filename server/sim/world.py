@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from server.sim.geometry import distance_to_nearest, segment_arrays
 from server.sim.world_file import (
     KNOWN_ROBOT_IDS,
     MAP_CELL_CHARS,
@@ -137,12 +138,9 @@ class World:
         """Distance [m] from (x, y) to the nearest wall, box edge or cylinder surface; negative
         inside a box or cylinder, inf in an empty world. A disc robot of radius r fits if >= r."""
         point = np.array([x, y], dtype=float)
-        nearest = math.inf
-        if len(self.segments):
-            nearest = float(_point_segment_distance(point, self.segments).min())
-        if len(self.circles):
-            gaps = np.hypot(*(self.circles[:, :2] - point).T) - self.circles[:, 2]
-            nearest = min(nearest, float(gaps.min()))
+        nearest = distance_to_nearest(
+            point, segment_arrays(self.segments), self.circles[:, :2], self.circles[:, 2]
+        )
         for cx, cy, width, depth, yaw, _height in self.boxes:
             c, s = math.cos(yaw), math.sin(yaw)
             u, v = c * (x - cx) + s * (y - cy), -s * (x - cx) + c * (y - cy)
@@ -155,15 +153,6 @@ class World:
         """Whether (x, y) [m] lies within `bounds` (edges included)."""
         min_x, min_y, max_x, max_y = self.bounds
         return min_x <= x <= max_x and min_y <= y <= max_y
-
-
-def _point_segment_distance(point: np.ndarray, segments: np.ndarray) -> np.ndarray:
-    """Distances [m] from one point to each (x1, y1, x2, y2) row."""
-    start, delta = segments[:, :2], segments[:, 2:] - segments[:, :2]
-    length_sq = np.maximum((delta**2).sum(axis=1), 1e-18)
-    t = np.clip(((point - start) * delta).sum(axis=1) / length_sq, 0.0, 1.0)
-    closest = start + t[:, None] * delta
-    return np.hypot(*(closest - point).T)
 
 
 def rasterize(

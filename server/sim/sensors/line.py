@@ -19,13 +19,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from sandbox.msgs.std_msgs import Int32MultiArray
-from server.sim.sensors.base import SenseContext, StatelessSensor
+from server.sim.geometry import offsets_from_segments, segment_arrays
+from server.sim.sensors.adc import ADC_MAX_COUNT, AdcPair
+from server.sim.sensors.base import SenseContext
 from server.sim.sensors.mount import Mount
 
-ADC_MAX_COUNT = 4095
 SPOT_RADIUS_M = 0.004
-NOISE_COUNTS = 20.0
+NOISE_COUNTS = 20.0  # [counts]
 RIGHT_SENSOR = Mount(x_m=0.045, y_m=-0.012)
 LEFT_SENSOR = Mount(x_m=0.045, y_m=0.012)
 
@@ -35,33 +35,20 @@ def tape_darkening(world, x: float, y: float) -> float:
     tapes = world.tape_segments
     if len(tapes) == 0:
         return 0.0
-    start = tapes[:, 0:2]
-    edge = tapes[:, 2:4] - start
-    length_sq = np.maximum(np.sum(edge * edge, axis=1), 1e-18)
-    rel = np.array([x, y]) - start
-    along = np.clip(np.sum(rel * edge, axis=1) / length_sq, 0.0, 1.0)
-    offset = rel - along[:, None] * edge
-    distance = np.hypot(offset[:, 0], offset[:, 1])
+    _, distance = offsets_from_segments(np.array([x, y]), *segment_arrays(tapes))
     # Coverage ramps from 1 (spot inside the tape) to 0 (spot clear of it) across the edge.
     half_width = world.tape_width / 2.0
     coverage = np.clip((half_width + SPOT_RADIUS_M - distance) / (2 * SPOT_RADIUS_M), 0.0, 1.0)
     return float(np.max(coverage * world.tape_darkness))
 
 
-class LineSensors(StatelessSensor):
+class LineSensors(AdcPair):
     """Two 12-bit reflectance readings [right, left]; dark tape reads high."""
 
-    msg_type = Int32MultiArray
-
     def __init__(self, rate_hz: float) -> None:
-        self.rate_hz = rate_hz
-        self.mounts = (RIGHT_SENSOR, LEFT_SENSOR)
+        super().__init__(rate_hz, RIGHT_SENSOR, LEFT_SENSOR, NOISE_COUNTS)
 
-    def sample(self, ctx: SenseContext, rng: np.random.Generator) -> Int32MultiArray:
-        readings = []
-        for mount, noise in zip(self.mounts, rng.normal(0.0, NOISE_COUNTS, 2), strict=True):
-            x, y, _ = mount.in_world(ctx.state.pose)
-            reflectance = ctx.world.floor_reflectance * (1.0 - tape_darkening(ctx.world, x, y))
-            raw = ADC_MAX_COUNT * (1.0 - reflectance) + noise
-            readings.append(max(0, min(ADC_MAX_COUNT, round(raw))))
-        return Int32MultiArray(data=readings)
+    def raw_count(self, mount: Mount, ctx: SenseContext) -> float:
+        x, y, _ = mount.in_world(ctx.state.pose)
+        reflectance = ctx.world.floor_reflectance * (1.0 - tape_darkening(ctx.world, x, y))
+        return ADC_MAX_COUNT * (1.0 - reflectance)
