@@ -2,25 +2,18 @@
 (where a sensor sits on the robot is `server.sim.sensors.mount.Mount`).
 
 Conventions (REP 103): x forward, y left, yaw counter-clockwise from +x [rad]; angles are
-reported wrapped to (-pi, pi].
+reported wrapped to (-pi, pi] (`server.sim.kinematics.wrap_angle`).
 """
 
 from __future__ import annotations
 
 import math
 
-import numpy as np
-
 from sandbox.msgs import Time
 from sandbox.msgs.geometry_msgs import Quaternion
 from sandbox.msgs.std_msgs import Header
 
 TWO_PI = 2.0 * math.pi
-
-
-def wrap_angle(angle_rad: float | np.ndarray) -> float | np.ndarray:
-    """Wrap an angle (or an array of angles) [rad] to (-pi, pi]."""
-    return angle_rad - TWO_PI * np.ceil((angle_rad - math.pi) / TWO_PI)
 
 
 def yaw_quaternion(yaw_rad: float) -> Quaternion:

@@ -25,13 +25,9 @@ import numpy as np
 from sandbox.msgs.geometry_msgs import Vector3
 from sandbox.msgs.sensor_msgs import Imu as ImuMessage
 from sandbox.msgs.std_msgs import Float32
+from server.sim.kinematics import wrap_angle
 from server.sim.sensors.base import SenseContext
-from server.sim.sensors.frames import (
-    diagonal_covariance,
-    stamped_header,
-    wrap_angle,
-    yaw_quaternion,
-)
+from server.sim.sensors.frames import diagonal_covariance, stamped_header, yaw_quaternion
 
 # Defaults (assumptions of BNO055 order unless noted)
 # | name                      | value  | unit        | why                                     |

@@ -28,13 +28,9 @@ import numpy as np
 from sandbox.msgs.geometry_msgs import Point, Pose, Twist, Vector3
 from sandbox.msgs.nav_msgs import Odometry
 from sandbox.msgs.std_msgs import Int32MultiArray
+from server.sim.kinematics import wrap_angle
 from server.sim.sensors.base import SenseContext, StatelessSensor
-from server.sim.sensors.frames import (
-    diagonal_covariance,
-    stamped_header,
-    wrap_angle,
-    yaw_quaternion,
-)
+from server.sim.sensors.frames import diagonal_covariance, stamped_header, yaw_quaternion
 
 # Defaults
 # | name                    | value  | unit   | why                                              |
@@ -114,7 +110,7 @@ class Bumper(StatelessSensor):
 
     def pressed(self, contact_angles_rad: tuple[float, ...]) -> tuple[int, int]:
         """(left, right), 1 = pressed, for contacts at these robot-frame angles [rad]."""
-        angles = np.asarray(wrap_angle(np.asarray(contact_angles_rad, dtype=np.float64)))
+        angles = np.array([wrap_angle(float(a)) for a in contact_angles_rad], dtype=np.float64)
         head_on = np.abs(angles) < self.both_within_rad
         left = (angles > 0.0) & (angles <= self.side_limit_rad)
         right = (angles <= 0.0) & (angles >= -self.side_limit_rad)
