@@ -33,6 +33,7 @@ import numpy as np
 from sandbox.msgs import Time
 from sandbox.msgs.sensor_msgs import Range
 from sandbox.msgs.std_msgs import Header, Int32
+from server.sim.sensors.adc import ADC_MAX_COUNT, adc_count
 from server.sim.sensors.base import SenseContext, StatelessSensor, fan
 from server.sim.sensors.mount import Mount
 
@@ -45,7 +46,6 @@ FIT_EXPONENT = -1.173
 NO_TARGET_VOLTS = 0.30
 VOLTAGE_NOISE_V = 0.02
 ADC_FULL_SCALE_V = 1.8
-ADC_MAX_COUNT = 4095
 DIVIDER_RATIO = 0.5
 GRAZING_MISS_INCIDENCE_RAD = math.radians(40.0)
 SERVO_CENTRE_DEG = 90.0  # servo angle that points the ranger straight ahead
@@ -103,8 +103,7 @@ class IrAdc(StatelessSensor):
 
     def sample(self, ctx: SenseContext, rng: np.random.Generator) -> Int32:
         volts = self.measurement.volts(ctx, rng) * DIVIDER_RATIO
-        count = round(volts / ADC_FULL_SCALE_V * ADC_MAX_COUNT)
-        return Int32(data=max(0, min(ADC_MAX_COUNT, count)))
+        return Int32(data=adc_count(volts / ADC_FULL_SCALE_V * ADC_MAX_COUNT))
 
 
 class IrRange(StatelessSensor):

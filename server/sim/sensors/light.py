@@ -22,15 +22,12 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
-from sandbox.msgs.std_msgs import Int32MultiArray
-from server.sim.sensors.base import SenseContext, StatelessSensor
+from server.sim.sensors.adc import ADC_MAX_COUNT, AdcPair
+from server.sim.sensors.base import SenseContext
 from server.sim.sensors.mount import Mount
 
-ADC_MAX_COUNT = 4095
 SATURATION_DISTANCE_M = 0.3
-NOISE_COUNTS = 12.0
+NOISE_COUNTS = 12.0  # [counts]
 RIGHT_SENSOR = Mount(x_m=0.04, y_m=-0.03, yaw_rad=math.radians(-30.0))
 LEFT_SENSOR = Mount(x_m=0.04, y_m=0.03, yaw_rad=math.radians(30.0))
 
@@ -48,18 +45,11 @@ def illuminance(mount: Mount, ctx: SenseContext) -> float:
     return total
 
 
-class LightSensors(StatelessSensor):
+class LightSensors(AdcPair):
     """Two 12-bit light readings [right, left]."""
 
-    msg_type = Int32MultiArray
-
     def __init__(self, rate_hz: float) -> None:
-        self.rate_hz = rate_hz
-        self.mounts = (RIGHT_SENSOR, LEFT_SENSOR)
+        super().__init__(rate_hz, RIGHT_SENSOR, LEFT_SENSOR, NOISE_COUNTS)
 
-    def sample(self, ctx: SenseContext, rng: np.random.Generator) -> Int32MultiArray:
-        readings = []
-        for mount, noise in zip(self.mounts, rng.normal(0.0, NOISE_COUNTS, 2), strict=True):
-            raw = ADC_MAX_COUNT * (1.0 - min(1.0, illuminance(mount, ctx))) + noise
-            readings.append(max(0, min(ADC_MAX_COUNT, round(raw))))
-        return Int32MultiArray(data=readings)
+    def raw_count(self, mount: Mount, ctx: SenseContext) -> float:
+        return ADC_MAX_COUNT * (1.0 - min(1.0, illuminance(mount, ctx)))
