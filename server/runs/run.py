@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import logging
 import math
-import queue
 import threading
 import time
 import uuid
@@ -29,7 +28,8 @@ from sandbox.msgs.std_msgs import Header
 from sandbox.node_process import NodeProcess
 from sandbox.protocol import Clock, Envelope, Exited, NodeInfo, Outcome, RobotTopic, Yield
 from server.runs.bus import ROBOT, RUN, TopicBus
-from server.runs.faults import Fault, FaultKind, Faults
+from server.runs.controls import RunControls
+from server.runs.faults import Faults
 from server.runs.metrics import NodeMetrics
 from server.runs.recorder import Recorder
 from server.runs.result import RunEnd, RunResult
@@ -69,7 +69,7 @@ class NodeSlot:
         return self.spec.name
 
 
-class Run:
+class Run(RunControls):
     def __init__(
         self,
         spec: RunSpec,
@@ -86,7 +86,7 @@ class Run:
         self.reason = ""
         self.time_ns = 0
         self.duration_ns = round(spec.duration_s * NS)
-        self._controls: queue.SimpleQueue = queue.SimpleQueue()
+        RunControls.__init__(self)
         self._state_lock = threading.Lock()
         self.faults = Faults()
         self.slots = {node.name: NodeSlot(node) for node in spec.nodes}
@@ -95,82 +95,6 @@ class Run:
         self.recorder: Recorder | None = None
         self._next_tf_ns = 0
         self.clock_wall_s = 0.0  # wall time the clock ran (node start-up excluded)
-
-    # ----------------------------------------------------------------------------- controls
-    # Called from other threads; applied by the loop between two steps.
-    def stop(self, reason: str = "stopped by the user") -> None:
-        self._controls.put(("stop", reason))
-
-    def pause(self) -> None:
-        if self.spec.clock is not Clock.LOCKSTEP:
-            raise ValueError("only a lockstep (simulated-time) run can pause; stop it instead")
-        self._controls.put(("pause", None))
-
-    def resume(self) -> None:
-        self._controls.put(("resume", None))
-
-    def press_button(self, pressed: bool) -> None:
-        self._controls.put(("button", bool(pressed)))
-
-    def move_light(self, name: str, x: float, y: float) -> None:
-        self._controls.put(("light", (name, float(x), float(y))))
-
-    def set_goal(self, x: float, y: float, yaw: float = 0.0) -> None:
-        if not all(math.isfinite(v) for v in (x, y, yaw)):
-            raise ValueError(f"a goal needs finite numbers, got ({x}, {y}, {yaw})")
-        self._controls.put(("goal", (float(x), float(y), float(yaw))))
-
-    def inject_fault(self, kind: FaultKind | str, topic: str | None, duration_s: float) -> None:
-        kind = FaultKind(kind)
-        if kind is not FaultKind.STALL_MOTORS and not topic:
-            raise ValueError(f"fault {kind} needs the topic it affects")
-        if not (math.isfinite(duration_s) and duration_s > 0):
-            raise ValueError(f"a fault lasts a positive number of seconds, got {duration_s}")
-        self._controls.put(("fault", (kind, topic, duration_s)))
-
-    @property
-    def progress(self) -> tuple[float, float]:
-        """(run time [s], duration [s])."""
-        return self.time_ns / NS, self.spec.duration_s
-
-    def _apply_controls(self) -> None:
-        while True:
-            try:
-                action, value = self._controls.get_nowait()
-            except queue.Empty:
-                return
-            self._apply_control(action, value)
-
-    def _apply_control(self, action: str, value: object) -> None:
-        if action == "stop":
-            raise RunEnd(RunState.INTERRUPTED, f"interrupted: {value}")
-        if action == "pause" and self.state is RunState.RUNNING:
-            self._move(RunState.PAUSED)
-        elif action == "resume" and self.state is RunState.PAUSED:
-            self._move(RunState.RUNNING)
-        elif action == "button":
-            self.sim.press_button(value)
-        elif action == "light":
-            name, x, y = value
-            try:
-                self.sim.move_light(name, x, y)
-            except SimulationError as error:
-                log.info("run %s: light not moved: %s", self.run_id, error)
-        elif action == "goal":
-            self._publish_goal(*value)
-        elif action == "fault":
-            kind, topic, duration_s = value
-            self.faults.add(Fault(kind, topic, self.time_ns + round(duration_s * NS)))
-            if kind is FaultKind.STALL_MOTORS:
-                self._stall_motors()
-
-    def wait_while_paused(self, timeout_s: float) -> None:
-        """Block up to `timeout_s` for a control while paused (the loop calls this)."""
-        try:
-            action, value = self._controls.get(timeout=timeout_s)
-        except queue.Empty:
-            return
-        self._apply_control(action, value)
 
     # ----------------------------------------------------------------------------- lifecycle
     def _move(self, new: RunState) -> None:
@@ -291,6 +215,7 @@ class Run:
         else:
             metrics, paths = self.metrics(), {}
         self.reason = reason
+        self._close_controls()
         self._move(end_state)
         return RunResult(
             run_id=self.run_id,

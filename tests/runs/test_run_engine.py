@@ -11,7 +11,8 @@ import pytest
 from mcap.reader import make_reader
 
 from sandbox.protocol import Clock
-from server.runs.run import FaultKind, Run
+from server.runs.faults import FaultKind
+from server.runs.run import Run
 from server.runs.spec import NodeSpec, RunSpec, RunSpecError
 from server.runs.state import RunState
 
