@@ -115,9 +115,17 @@ def run_realtime(run: Run) -> None:
                 run.begin_wake(slot, run.time_ns)
         # Sleep until the next thing to do: a node's wake time, the robot's next message, a
         # reply (its fds wake the poll), or a short idle tick to look at controls.
+        # (A node still computing is not due: its reply wakes the poll below.)
         next_ns = min(
             [run.duration_ns, round(run.sim.next_publication_s() * NS)]
-            + [s.wake_at_ns for s in order if not s.done and s.wake_at_ns is not None]
+            + [
+                s.wake_at_ns
+                for s in order
+                if not s.done
+                and s.wake_at_ns is not None
+                and s.process is not None
+                and s.process.state == "sleeping"
+            ]
         )
         wait_s = min(REALTIME_IDLE_S, max(0.0, next_ns / NS - (time.monotonic() - start)))
         wanted = {
