@@ -10,13 +10,16 @@ recording, byte for byte.
 *Realtime* (wall clock, real-time factor 1): the simulation keeps advancing while nodes compute,
 so a slow controller shows up as latency, as on a real robot. Nodes are woken without waiting
 (`begin_wake`) and their replies collected as they come, so one slow node does not hold up the
-others; a command takes effect at the moment its reply arrives.
+others; a command takes effect at the moment its reply arrives. Every realtime run of the
+process is driven by one scheduler thread (earliest deadline first), not a thread each.
 """
 
 from __future__ import annotations
 
+import contextlib
+import os
 import select
-import sys
+import threading
 import time
 from typing import TYPE_CHECKING
 
@@ -32,7 +35,6 @@ MAX_ROUNDS_PER_INSTANT = 100
 # [s] longest the realtime loop sleeps when nothing is due; controls and node replies wake it
 # earlier through their fds, so this only bounds how stale `progress` can look.
 REALTIME_IDLE_S = 0.05
-GIL_SWITCH_INTERVAL_S = 0.0005  # [s] see run_realtime
 
 
 def run_lockstep(run: Run) -> None:
@@ -82,23 +84,26 @@ def _next_event_ns(run: Run) -> int:
     return max(next_ns, run.time_ns + tick_ns)  # always move on by at least one tick
 
 
-def run_realtime(run: Run) -> None:
-    # Many realtime runs share one interpreter; Python hands the GIL over every 5 ms by
-    # default, which shows up as periods 5-20 ms late. A shorter interval costs a little
-    # throughput and keeps wake-ups on time. (Process-wide, and harmless for lockstep runs.)
-    if sys.getswitchinterval() > GIL_SWITCH_INTERVAL_S:
-        sys.setswitchinterval(GIL_SWITCH_INTERVAL_S)
-    start = time.monotonic()
-    order = list(run.slots.values())
-    poller = select.poll()
-    poller.register(run.control_signal_fd, select.POLLIN)
-    watched: set[int] = set()
-    while True:
+class RealtimeDriver:
+    """One realtime run, advanced in non-blocking steps by the shared scheduler."""
+
+    def __init__(self, run: Run) -> None:
+        self.run = run
+        self.start = time.monotonic()
+        self.order = list(run.slots.values())
+        self.deadline = self.start  # monotonic time of the next thing to do
+        self.fds: list[int] = [run.control_signal_fd]
+        self.finished = threading.Event()
+        self.error: BaseException | None = None
+
+    def step(self) -> bool:
+        """Do what is due now; False once the run's duration is reached."""
+        run, order = self.run, self.order
         run._apply_controls()
-        now_ns = round((time.monotonic() - start) * NS)
+        now_ns = round((time.monotonic() - self.start) * NS)
         run.advance_to(min(now_ns, run.duration_ns))
         if run.time_ns >= run.duration_ns:
-            return
+            return False
         for slot in order:
             if slot.done or slot.process is None:
                 continue
@@ -113,31 +118,101 @@ def run_realtime(run: Run) -> None:
                 or (slot.wake_at_ns is None and run.bus.has_pending(slot.name))
             ):
                 run.begin_wake(slot, run.time_ns)
-        # Sleep until the next thing to do: a node's wake time, the robot's next message, a
-        # reply (its fds wake the poll), or a short idle tick to look at controls.
-        # (A node still computing is not due: its reply wakes the poll below.)
+        # Next: a sleeping node's wake time, the robot's next message, or an idle check; a
+        # node still computing is not due (its reply makes its fds readable).
+        running = [
+            s
+            for s in order
+            if not s.done and s.process is not None and s.process.state == "running"
+        ]
         next_ns = min(
             [run.duration_ns, round(run.sim.next_publication_s() * NS)]
             + [
                 s.wake_at_ns
                 for s in order
-                if not s.done
-                and s.wake_at_ns is not None
-                and s.process is not None
-                and s.process.state == "sleeping"
+                if not s.done and s.wake_at_ns is not None and s not in running
             ]
         )
-        wait_s = min(REALTIME_IDLE_S, max(0.0, next_ns / NS - (time.monotonic() - start)))
-        wanted = {
-            fd
-            for s in order
-            if not s.done and s.process is not None and s.process.state == "running"
-            for fd in s.process.reply_fds
-        }
-        for fd in watched - wanted:
-            poller.unregister(fd)
-        for fd in wanted - watched:
-            poller.register(fd, select.POLLIN)
-        watched = wanted
-        if wait_s > 0:
-            poller.poll(wait_s * 1000.0)
+        self.deadline = min(self.start + next_ns / NS, time.monotonic() + REALTIME_IDLE_S)
+        self.fds = [run.control_signal_fd] + [fd for s in running for fd in s.process.reply_fds]
+        return True
+
+
+class RealtimeScheduler:
+    """One thread that drives every realtime run of the process, earliest deadline first.
+
+    Twenty run threads contending for the GIL made wake-ups tens of milliseconds late; one
+    thread that sleeps in select() until the earliest deadline or the first node reply keeps
+    them on time and spends less CPU. A run that raises ends alone; the others go on.
+    """
+
+    def __init__(self) -> None:
+        self._drivers: list[RealtimeDriver] = []
+        self._lock = threading.Lock()
+        self._wakeup_r, self._wakeup_w = os.pipe()
+        os.set_blocking(self._wakeup_r, False)
+        self._thread = threading.Thread(target=self._loop, name="realtime-runs", daemon=True)
+        self._thread.start()
+
+    def add(self, driver: RealtimeDriver) -> None:
+        with self._lock:
+            self._drivers.append(driver)
+        os.write(self._wakeup_w, b"!")
+
+    def _loop(self) -> None:
+        while True:
+            with self._lock:
+                drivers = list(self._drivers)
+            now = time.monotonic()
+            due = [d for d in drivers if d.deadline <= now]
+            if not due:
+                owner = {fd: d for d in drivers for fd in d.fds}
+                timeout = min((d.deadline for d in drivers), default=now + 1.0) - now
+                readable = _wait_readable([self._wakeup_r, *owner], max(0.0, timeout))
+                if self._wakeup_r in readable:
+                    with contextlib.suppress(BlockingIOError):
+                        os.read(self._wakeup_r, 4096)
+                now = time.monotonic()
+                due = {owner[fd] for fd in readable if fd in owner}
+                due.update(d for d in drivers if d.deadline <= now)
+            for driver in due:
+                self._step(driver)
+
+    def _step(self, driver: RealtimeDriver) -> None:
+        try:
+            going_on = driver.step()
+        except BaseException as error:  # RunEnd, or a fault: it ends this run only
+            driver.error = error
+            going_on = False
+        if not going_on:
+            with self._lock:
+                self._drivers.remove(driver)
+            driver.finished.set()
+
+
+def _wait_readable(fds: list[int], timeout_s: float) -> list[int]:
+    """select() has microsecond timeouts (poll() only milliseconds, a 1 ms jitter on every
+    wake-up) but cannot watch fd numbers past FD_SETSIZE; fall back to poll() then."""
+    if max(fds) < 1024:
+        return select.select(fds, [], [], timeout_s)[0]
+    poller = select.poll()
+    for fd in fds:
+        poller.register(fd, select.POLLIN)
+    return [fd for fd, _ in poller.poll(timeout_s * 1000.0)]
+
+
+_scheduler: RealtimeScheduler | None = None
+_scheduler_lock = threading.Lock()
+
+
+def run_realtime(run: Run) -> None:
+    """Drive `run` on the shared realtime scheduler; return (or raise its end) when done."""
+    global _scheduler
+    with _scheduler_lock:
+        if _scheduler is None:
+            _scheduler = RealtimeScheduler()
+    driver = RealtimeDriver(run)
+    _scheduler.add(driver)
+    driver.finished.wait()
+    if driver.error is not None:
+        raise driver.error

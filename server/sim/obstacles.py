@@ -23,7 +23,8 @@ to ~0.35 ms (`python3 -m bench.bench_scans`).
 Fallback: casts with one origin per ray ((K, 2) origins), casts from inside a cylinder (range 0
 for every ray: a degenerate case where interval culling buys nothing) and small casts (a few rays
 or surfaces, where culling's fixed cost exceeds its savings) use `_cast_dense`, which is also what
-the tests compare the culled path against.
+the tests compare the culled path against. The smallest casts (an ultrasonic cone, an IR beam:
+up to `_FEW_MAX_PAIRS` ray x surface pairs) go through `raycast_few`, a plain Python loop.
 """
 
 from __future__ import annotations
@@ -34,6 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from server.sim.geometry import distance_to_nearest, offsets_from_segments, segment_arrays
+from server.sim.raycast_few import Circle, Segment, cast_few
 from server.sim.world import World
 
 _PARALLEL_EPS = 1e-12  # [m^2] |cross(d, e)| below this: ray parallel to the segment, no hit
@@ -44,6 +46,8 @@ _TWO_PI = 2.0 * math.pi
 # Rays x surfaces up to which the dense path is no slower than culling's fixed cost (~60 numpy
 # calls): measured crossover ~3000-5000 pairs (e.g. 60 rays in the 49-surface office).
 _DENSE_MAX_PAIRS = 4000
+# Up to this many ray x surface pairs, a plain Python loop beats numpy's per-call overhead.
+_FEW_MAX_PAIRS = 160
 
 
 @dataclass(frozen=True, slots=True)
@@ -114,6 +118,19 @@ class Obstacles:
         self._edge_x, self._edge_y = np.array(self.segment_vector.T)
         self._normal_x, self._normal_y = np.array(self.segment_normal.T)
         self._circle_x, self._circle_y = np.array(self.circle_centre.T)
+        # The same surfaces as plain tuples for `cast_few`.
+        self._few_segments = [
+            Segment(*row)
+            for row in np.column_stack(
+                [self.segment_start, self.segment_vector, self.segment_normal, self.segment_height]
+            ).tolist()
+        ]
+        self._few_circles = [
+            Circle(x, y, r * r, h)
+            for x, y, r, h in np.column_stack(
+                [self.circle_centre, self.circle_radius, self.circle_height]
+            ).tolist()
+        ]
 
     def cast(
         self,
@@ -128,6 +145,21 @@ class Obstacles:
         origin = np.asarray(origin_xy, dtype=np.float64)
         angles = np.asarray(angles_rad, dtype=np.float64).reshape(-1)
         surface_count = self.segment_height.size + self.circle_height.size
+        if origin.shape == (2,) and angles.size * surface_count <= _FEW_MAX_PAIRS:
+            distances, cosines = cast_few(
+                self._few_segments,
+                self._few_circles,
+                float(origin[0]),
+                float(origin[1]),
+                angles.tolist(),
+                max_range_m,
+                min_height_m,
+            )
+            cos_incidence = np.array(cosines)
+            return RayHits(
+                distance_m=np.array(distances),
+                incidence_rad=np.arccos(np.clip(cos_incidence, 0.0, 1.0)),
+            )
         if origin.shape == (2,) and angles.size * surface_count > _DENSE_MAX_PAIRS:
             return self._cast_culled(origin, angles, max_range_m, min_height_m)
         return self._cast_dense(origin, angles, max_range_m, min_height_m)

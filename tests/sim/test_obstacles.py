@@ -209,3 +209,37 @@ def test_clearance_to_cylinders_and_walls() -> None:
     assert obstacles.clearance(3.0, 2.0) == pytest.approx(1.0)
     assert obstacles.clearance(3.0, 4.5) < 0.0  # inside the cylinder
     assert Obstacles(make_world()).clearance(0.0, 0.0) == math.inf
+
+
+@pytest.mark.parametrize("world_id", ["wall_approach", "light_arena", "obstacle_maze"])
+def test_few_ray_python_cast_matches_dense(world_id: str) -> None:
+    obstacles = Obstacles(load_world(world_id))
+    rng = np.random.default_rng(11)
+    surfaces = obstacles.segment_height.size + obstacles.circle_height.size
+    rays = max(1, min(7, 160 // surfaces))  # small enough for the plain-Python path
+    for _ in range(300):
+        origin = rng.uniform([0.0, 0.0], [3.0, 2.5])
+        angles = rng.uniform(-math.pi, math.pi) + np.linspace(-0.13, 0.13, rays)
+        min_height = float(rng.choice([0.0, 0.2]))
+        few = obstacles.cast(origin, angles, 2.0, min_height)
+        dense = obstacles._cast_dense(origin, angles, 2.0, min_height)
+        np.testing.assert_array_equal(np.isinf(few.distance_m), np.isinf(dense.distance_m))
+        finite = np.isfinite(dense.distance_m)
+        np.testing.assert_allclose(few.distance_m[finite], dense.distance_m[finite], atol=1e-9)
+        np.testing.assert_allclose(
+            few.incidence_rad[finite], dense.incidence_rad[finite], atol=1e-7
+        )
+
+
+def test_few_ray_cast_with_circles_and_heights() -> None:
+    world = make_world(
+        segments=[(1.0, -1.0, 1.0, 1.0), (0.5, 0.3, 0.8, 0.3)],
+        segment_height=[0.3, 0.1],
+        circles=[(0.6, 0.0, 0.05), (0.0, 0.0, 0.2)],
+    )
+    obstacles = Obstacles(world)
+    angles = np.linspace(-0.5, 0.5, 9)
+    for origin, min_height in (((0.0, 0.5), 0.0), ((0.0, 0.5), 0.2), ((0.0, 0.0), 0.0)):
+        few = obstacles.cast(np.array(origin), angles, 3.0, min_height)
+        dense = obstacles._cast_dense(np.array(origin), angles, 3.0, min_height)
+        np.testing.assert_allclose(few.distance_m, dense.distance_m, atol=1e-12)
