@@ -19,6 +19,7 @@ from __future__ import annotations
 import contextlib
 import os
 import select
+import sys
 import threading
 import time
 from typing import TYPE_CHECKING
@@ -35,6 +36,7 @@ MAX_ROUNDS_PER_INSTANT = 100
 # [s] longest the realtime loop sleeps when nothing is due; controls and node replies wake it
 # earlier through their fds, so this only bounds how stale `progress` can look.
 REALTIME_IDLE_S = 0.05
+GIL_SWITCH_INTERVAL_S = 0.0005  # [s] see run_realtime
 
 
 def run_lockstep(run: Run) -> None:
@@ -208,6 +210,11 @@ _scheduler_lock = threading.Lock()
 def run_realtime(run: Run) -> None:
     """Drive `run` on the shared realtime scheduler; return (or raise its end) when done."""
     global _scheduler
+    # Other threads (recorders writing chunks) hold the GIL for up to the switch interval,
+    # 5 ms by default, each time the scheduler wants it back; that lands on wake-ups as
+    # lateness. A shorter interval keeps them on time. (Process-wide; lockstep is unaffected.)
+    if sys.getswitchinterval() > GIL_SWITCH_INTERVAL_S:
+        sys.setswitchinterval(GIL_SWITCH_INTERVAL_S)
     with _scheduler_lock:
         if _scheduler is None:
             _scheduler = RealtimeScheduler()
