@@ -259,3 +259,125 @@ def test_bad_specs_are_sentences(changes, message):
 def test_missing_node_file_is_a_sentence(tmp_path):
     with pytest.raises(RunSpecError, match="does not exist"):
         NodeSpec.from_file(tmp_path / "nope.py")
+
+
+# The four nodes of 002_3fcfeb7b4c14107a.txt (Fig. 8) with the paper's topic names, each a
+# sandboxed node: sensor -> distance_detect -> servo -> dist_detect_left/right -> compare_distance
+# -> direction -> dc_motor -> forward -> servo. Minimal logic: the point is the graph.
+PAPER_NODES = {
+    "sensor": """
+import rospy
+from std_msgs.msg import Int32, Float32
+rospy.init_node("sensor")
+pub = rospy.Publisher("distance_detect", Float32, queue_size=1)
+rospy.Subscriber("ir_adc", Int32, lambda m: pub.publish(Float32(m.data / 10.0)))
+rospy.spin()
+""",
+    "servo": """
+import rospy
+from std_msgs.msg import Float32, Int16, Int32
+rospy.init_node("servo")
+right = rospy.Publisher("dist_detect_right", Int16, queue_size=1)
+left = rospy.Publisher("dist_detect_left", Int16, queue_size=1)
+stop = rospy.Publisher("dist_detect", Int16, queue_size=1)
+angle = rospy.Publisher("servo_angle", Int16, queue_size=1)
+def on_distance(msg):
+    right.publish(Int16(int(msg.data)))
+    left.publish(Int16(int(msg.data) + 1))
+    stop.publish(Int16(0))
+rospy.Subscriber("distance_detect", Float32, on_distance)
+rospy.Subscriber("forward", Int32, lambda m: angle.publish(Int16(90)))
+rospy.spin()
+""",
+    "compare_distance": """
+import rospy
+from std_msgs.msg import Int16, String
+rospy.init_node("compare_distance")
+direction = rospy.Publisher("direction", String, queue_size=1)
+seen = {}
+def compare(side):
+    def on(msg):
+        seen[side] = msg.data
+        if len(seen) == 2:
+            direction.publish(String("left" if seen["left"] > seen["right"] else "right"))
+    return on
+rospy.Subscriber("dist_detect_left", Int16, compare("left"))
+rospy.Subscriber("dist_detect_right", Int16, compare("right"))
+rospy.spin()
+""",
+    "dc_motor": """
+import rospy
+from std_msgs.msg import Int16, Int32, String
+rospy.init_node("dc_motor")
+motor = rospy.Publisher("motor_command", String, queue_size=1)
+forward = rospy.Publisher("forward", Int32, queue_size=1)
+rospy.Subscriber("dist_detect", Int16, lambda m: None)
+def on_direction(msg):
+    motor.publish(String(msg.data))
+    forward.publish(Int32(1))
+rospy.Subscriber("direction", String, on_direction)
+rospy.spin()
+""",
+}
+
+
+def test_the_papers_four_node_graph_runs_as_four_sandboxes(tmp_path, launcher):
+    nodes = tuple(node(code, name) for name, code in PAPER_NODES.items())
+    spec = RunSpec(robot="ir_scout", world="obstacle_maze", nodes=nodes, duration_s=2.0)
+    result = Run(spec, launcher, tmp_path / "run").execute()
+    assert result.state is RunState.FINISHED, result.reason
+    topics = {t["name"]: t for t in result.graph["topics"]}
+    expected = {
+        "ir_adc": (["robot"], ["sensor"]),
+        "distance_detect": (["sensor"], ["servo"]),
+        "dist_detect_right": (["servo"], ["compare_distance"]),
+        "dist_detect_left": (["servo"], ["compare_distance"]),
+        "dist_detect": (["servo"], ["dc_motor"]),
+        "direction": (["compare_distance"], ["dc_motor"]),
+        "forward": (["dc_motor"], ["servo"]),
+        "motor_command": (["dc_motor"], []),
+        "servo_angle": (["servo"], []),
+    }
+    for name, (publishers, subscribers) in expected.items():
+        assert (topics[name]["publishers"], topics[name]["subscribers"]) == (
+            publishers,
+            subscribers,
+        ), name
+        assert topics[name]["messages"] > 0, name
+    # ir_adc comes at 25 Hz; compare_distance answers each of its two inputs: 50 Hz downstream.
+    assert topics["ir_adc"]["rate_hz"] == pytest.approx(25.0, rel=0.1)
+    assert topics["motor_command"]["rate_hz"] == pytest.approx(50.0, rel=0.1)
+
+
+class FailingSimRun(Run):
+    """A robot backend that raises after a while (the fault a broken driver would cause)."""
+
+    def _prepare(self) -> None:
+        super()._prepare()
+        real_step = self.sim.step
+
+        def step(dt_s: float):
+            if self.sim.time_s > 1.0:
+                raise RuntimeError("motor controller stopped answering")
+            return real_step(dt_s)
+
+        self.sim.step = step
+
+
+def test_a_raising_robot_backend_or_recorder_ends_only_its_run(tmp_path, launcher):
+    good = crowbot_run(tmp_path / "good", launcher, node(STEP_APPROACH), duration_s=6.0)
+    results = {}
+    thread = threading.Thread(target=lambda: results.setdefault("good", good.execute()))
+    thread.start()
+    spec = RunSpec("crowbot", "wall_approach", (node(STEP_APPROACH),), duration_s=5.0)
+    broken = FailingSimRun(spec, launcher, tmp_path / "broken").execute()
+    assert broken.state is RunState.FAILED
+    assert "motor controller stopped answering" in broken.reason
+    full_disk = tmp_path / "full"
+    full_disk.mkdir()
+    (full_disk / "recording.mcap").symlink_to("/dev/full")
+    recorder_fails = Run(spec, launcher, full_disk).execute()
+    assert recorder_fails.state is RunState.FAILED
+    assert "recording failed" in recorder_fails.reason and "No space left" in recorder_fails.reason
+    thread.join(timeout=60)
+    assert results["good"].state is RunState.FINISHED
