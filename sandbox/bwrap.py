@@ -15,6 +15,7 @@ What the node sees:
 
 from __future__ import annotations
 
+import importlib.util
 import os
 import shutil
 import site
@@ -62,6 +63,13 @@ def _python_roots() -> list[str]:
     return roots
 
 
+def _installed_server_dir() -> str | None:
+    spec = importlib.util.find_spec("server")
+    if spec is None or not spec.submodule_search_locations:
+        return None
+    return os.path.realpath(next(iter(spec.submodule_search_locations)))
+
+
 def sandbox_package_dir() -> str:
     return str(Path(sandbox.__file__).resolve().parent)
 
@@ -103,8 +111,14 @@ def build_command(
         "--size", str(scratch_bytes), "--tmpfs", SCRATCH_DIR,
         "--chdir", SCRATCH_DIR,
     ]  # fmt: skip
-    for root in _python_roots():
+    roots = _python_roots()
+    for root in roots:
         command += ["--ro-bind", root, root]
+    # A regular (not editable) install puts `server` into site-packages, which is bound above:
+    # cover it with an empty directory so student code cannot import the server's code.
+    server_dir = _installed_server_dir()
+    if server_dir and any(server_dir.startswith(root + os.sep) for root in roots):
+        command += ["--tmpfs", server_dir]
     command += ["--ro-bind", sandbox_package_dir(), f"{SANDBOX_ROOT}/sandbox"]
     env = node_environment(SCRATCH_DIR)
     if font_cache:
