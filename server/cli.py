@@ -2,7 +2,7 @@
 
     robodojo robots                       # the robots, a line each (--topics for their topics)
     robodojo worlds                       # the worlds, a line each
-    robodojo run --robot crowbot --world wall_approach --node examples/crowbot/pid_distance.py
+    robodojo run --robot crowbot --world wall_approach --node examples/step_api/crowbot.py
     robodojo export RUN_DIR               # a CSV per topic from a run's recording
 
 `run` executes headless: a progress bar of simulated time on a terminal (plain lines when not a
@@ -131,6 +131,46 @@ def _cmd_run(args: argparse.Namespace) -> int:
     return 0 if result.state is RunState.FINISHED else 1
 
 
+def _cmd_exercises(_: argparse.Namespace) -> int:
+    from server.exercises.registry import exercise_ids, get_exercise
+
+    for exercise_id in exercise_ids():
+        exercise = get_exercise(exercise_id)
+        print(f"{exercise_id:<22} {exercise.title}  [{exercise.robot} in {exercise.world}]")
+    return 0
+
+
+def _cmd_check(args: argparse.Namespace) -> int:
+    from server.exercises.grading import grade, reference_nodes, starter_nodes
+    from server.exercises.registry import get_exercise
+
+    exercise = get_exercise(args.exercise)
+    if sum(bool(x) for x in (args.node, args.reference, args.starter)) != 1:
+        raise ValueError("give the code to check: --node FILE [...], --reference or --starter")
+    if args.reference:
+        nodes = reference_nodes(exercise)
+    elif args.starter:
+        nodes = starter_nodes(exercise)
+    else:
+        nodes = _node_specs(args.node)
+    launcher = Launcher(pool_size=len(nodes), unsafe_no_sandbox=args.unsafe_no_sandbox)
+    try:
+        result = grade(exercise, nodes, launcher, Path(args.out) if args.out else None)
+    finally:
+        launcher.close()
+    for run in result.runs:
+        if run["state"] != RunState.FINISHED:
+            print(f"seed {run['seed']}: {run['reason']}", file=sys.stderr)
+    for check in result.checks:
+        verdict = "pass" if check.passed else "FAIL"
+        print(
+            f"{verdict}  {check.name:<22} {check.value:10.4g} {check.unit:<2} "
+            f"(needs {check.comparison} {check.threshold:g})  {check.description}"
+        )
+    print(json.dumps(result.summary()))
+    return 0 if result.passed else 1
+
+
 def _cmd_export(args: argparse.Namespace) -> int:
     from server.runs.export import export_csv
 
@@ -183,6 +223,16 @@ def build_parser() -> argparse.ArgumentParser:
         help="DANGER: run student code without bubblewrap (trusted code on a laptop only)",
     )
     run.set_defaults(func=_cmd_run)
+
+    commands.add_parser("exercises", help="list the exercises").set_defaults(func=_cmd_exercises)
+    check = commands.add_parser("check", help="run an exercise headless and grade it")
+    check.add_argument("exercise", help="an exercise id (see `robodojo exercises`)")
+    check.add_argument("--node", action="append", default=[], metavar="[NAME=]FILE")
+    check.add_argument("--reference", action="store_true", help="check the reference solution")
+    check.add_argument("--starter", action="store_true", help="check the starter code")
+    check.add_argument("--out", default=None, help="folder for the runs' recordings")
+    check.add_argument("--unsafe-no-sandbox", action="store_true", help=argparse.SUPPRESS)
+    check.set_defaults(func=_cmd_check)
 
     export = commands.add_parser("export", help="write a CSV per topic from a run's recording")
     export.add_argument("run_dir", help="the --out folder of a run")

@@ -33,13 +33,13 @@ def test_headless_run_prints_a_json_summary_last(tmp_path):
     out = tmp_path / "run"
     done = robodojo(
         "run", "--robot", "crowbot", "--world", "wall_approach",
-        "--node", "examples/crowbot/pid_distance.py", "--duration", "5", "--out", str(out),
+        "--node", "examples/step_api/crowbot.py", "--duration", "5", "--out", str(out),
     )  # fmt: skip
     assert done.returncode == 0, done.stderr
     summary = json.loads(done.stdout.strip().splitlines()[-1])
     assert summary["state"] == "finished"
     assert summary["reason"] == "finished: duration reached"
-    assert summary["nodes"]["pid_distance"]["period"]["p50_s"] == pytest.approx(0.1)
+    assert summary["nodes"]["crowbot"]["period"]["p50_s"] == pytest.approx(0.05)
     assert (out / "recording.mcap").is_file() and (out / "metrics.json").is_file()
     exported = robodojo("export", str(out))
     assert exported.returncode == 0, exported.stderr
@@ -72,7 +72,7 @@ def test_failed_run_exits_non_zero_with_the_reason(tmp_path):
 )
 def test_newcomer_mistakes_get_a_sentence_not_a_traceback(args, message):
     base = {"--robot": "crowbot", "--world": "wall_approach",
-            "--node": "examples/crowbot/pid_distance.py", "--duration": "1"}  # fmt: skip
+            "--node": "examples/step_api/crowbot.py", "--duration": "1"}  # fmt: skip
     base[args[0]] = args[1]
     done = robodojo("run", *[item for pair in base.items() for item in pair])
     assert done.returncode == 2

@@ -70,6 +70,9 @@ def run_lockstep(run: Run) -> None:
 
 def _next_event_ns(run: Run) -> int:
     candidates = [run.duration_ns]
+    scripted = run.next_script_ns()
+    if scripted is not None:
+        candidates.append(scripted)
     spinning = False
     for slot in run.slots.values():
         if slot.done:
@@ -127,8 +130,10 @@ class RealtimeDriver:
             for s in order
             if not s.done and s.process is not None and s.process.state == "running"
         ]
+        scripted = run.next_script_ns()
         next_ns = min(
             [run.duration_ns, round(run.sim.next_publication_s() * NS)]
+            + ([scripted] if scripted is not None else [])
             + [
                 s.wake_at_ns
                 for s in order

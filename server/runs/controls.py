@@ -117,6 +117,7 @@ class RunControls:
             self._publish_goal(*value)
         elif action == "fault":
             kind, topic, duration_s = value
+            kind = FaultKind(kind)
             self.faults.add(Fault(kind, topic, self.time_ns + round(duration_s * NS)))
             if kind is FaultKind.STALL_MOTORS:
                 self._stall_motors()

@@ -95,6 +95,7 @@ class Run(RunControls):
         self.recorder: Recorder | None = None
         self._next_tf_ns = 0
         self.clock_wall_s = 0.0  # wall time the clock ran (node start-up excluded)
+        self._script = sorted(spec.script, key=lambda event: event[0])
 
     # ----------------------------------------------------------------------------- lifecycle
     def _move(self, new: RunState) -> None:
@@ -375,11 +376,18 @@ class Run(RunControls):
             for event in self.sim.drain_events():
                 if event.kind is EventKind.LEFT_BOUNDS:
                     log.debug("run %s: robot left the bounds at %.3f s", self.run_id, event.time_s)
+        while self._script and round(self._script[0][0] * NS) <= self.time_ns:
+            _, action, value = self._script.pop(0)
+            self._apply_control(action, value)
         self._check_robot()
         if self.time_ns >= self._next_tf_ns:
             self._record_tf()
         if self.recorder.error:
             raise RunEnd(RunState.FAILED, f"failed: {self.recorder.error}")
+
+    def next_script_ns(self) -> int | None:
+        """Run time of the next scripted control, if any (the clocks stop there)."""
+        return round(self._script[0][0] * NS) if self._script else None
 
     def _check_robot(self) -> None:
         pose = self.sim.state.pose

@@ -15,6 +15,7 @@ from server.sim import load_world, robot_ids, robots_for_world, world_ids
 MAX_DURATION_S = 3600.0  # [s] an hour of simulated time: longer is a mistake, not an exercise
 MAX_NODES = 8  # a launch file larger than this is not a student exercise
 MAX_CODE_BYTES = 256 * 1024  # [bytes] per node file
+SCRIPT_ACTIONS = ("light", "goal", "button", "fault")
 _NODE_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]{0,39}$")
 
 
@@ -59,6 +60,8 @@ class RunSpec:
     light_position: tuple[float, float] | None = None  # moves the world's first movable light
     goal: tuple[float, float, float] | None = None  # x [m], y [m], yaw [rad], on topic "goal"
     params: dict[str, object] = field(default_factory=dict)  # rospy.get_param values
+    # Scripted controls: (run time [s], action, value), e.g. (10.0, "light", ("lamp", 1.5, 1)).
+    script: tuple[tuple[float, str, object], ...] = ()
 
     def validate(self) -> None:
         """Raise RunSpecError naming the first problem found."""
@@ -101,6 +104,13 @@ class RunSpec:
             if len(node.code.encode()) > MAX_CODE_BYTES:
                 raise RunSpecError(
                     f"node '{node.name}' is larger than {MAX_CODE_BYTES // 1024} KiB of code"
+                )
+        for time_s, action, _ in self.script:
+            if not (isinstance(time_s, (int, float)) and 0 <= time_s <= self.duration_s):
+                raise RunSpecError(f"scripted '{action}' at {time_s!r} s is outside the run")
+            if action not in SCRIPT_ACTIONS:
+                raise RunSpecError(
+                    f"scripted action '{action}' is unknown; use one of {', '.join(SCRIPT_ACTIONS)}"
                 )
         for label, values in (
             ("initial_pose", self.initial_pose),

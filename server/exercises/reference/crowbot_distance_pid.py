@@ -1,8 +1,9 @@
 """Hold the CrowBot 0.2 m from the wall: the PID of 000_32b6074bbd2115c3.txt eq. 3-4 with the
 gains of Table 2 (Kp = Ki = Kd = 0.4) at 10 Hz, written as the paper's ROS 1 Python programs are:
-a subscriber callback keeps the latest distance, a Rate loop publishes the Twist.
+a subscriber callback keeps the latest distance, a Rate loop publishes the Twist. Reference
+solution of the `crowbot_distance_pid` exercise (not shown to students).
 
-    robodojo run --robot crowbot --world wall_approach --node examples/crowbot/pid_distance.py
+    robodojo check crowbot_distance_pid --reference
 """
 
 import rospy
@@ -13,6 +14,7 @@ KP, KI, KD = 0.4, 0.4, 0.4  # Table 2
 SETPOINT_M = 0.2  # d_d [m]
 RATE_HZ = 10  # [Hz] the paper's control rate
 MAX_SPEED_M_S = 0.128  # [m/s] what PWM 255 gives the wheels; beyond it the integral winds up
+INTEGRATE_WITHIN_M = 0.05  # [m] the integral only acts on the last few centimetres
 
 distance_m = None
 
@@ -36,7 +38,9 @@ while not rospy.is_shutdown():
         error = distance_m - SETPOINT_M
         derivative = 0.0 if previous_error is None else (error - previous_error) / period
         command = KP * error + KI * integral + KD * derivative
-        if abs(command) < MAX_SPEED_M_S:  # anti-windup: integrate only while not saturated
+        # Anti-windup: integrate only near the set point and while the wheels are not
+        # saturated; integrating the whole approach would carry the robot past 0.2 m.
+        if abs(command) < MAX_SPEED_M_S and abs(error) < INTEGRATE_WITHIN_M:
             integral += error * period
         previous_error = error
         move = Twist()

@@ -1,0 +1,1 @@
+"""The papers' experiments as exercises: starter code, a reference solution, automatic checks."""

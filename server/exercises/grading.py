@@ -1,0 +1,140 @@
+"""Grading: run an exercise's nodes on each of its seeds, compute every check from each run's
+recording, and judge each check by its worst seed."""
+
+from __future__ import annotations
+
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+from sandbox.launcher import Launcher
+from server.exercises.evidence import load_evidence
+from server.exercises.model import Exercise
+from server.runs.run import Run
+from server.runs.spec import NodeSpec, RunSpec
+from server.runs.state import RunState
+
+
+@dataclass(frozen=True, slots=True)
+class CheckResult:
+    name: str
+    description: str
+    value: float
+    threshold: float
+    comparison: str
+    unit: str
+    passed: bool
+    per_seed: tuple[float, ...]
+
+
+@dataclass(frozen=True, slots=True)
+class Grade:
+    exercise: str
+    checks: tuple[CheckResult, ...]
+    runs: tuple[dict, ...]  # per seed: seed, state, reason, run_dir
+
+    @property
+    def passed(self) -> bool:
+        return all(check.passed for check in self.checks) and all(
+            run["state"] == RunState.FINISHED for run in self.runs
+        )
+
+    @property
+    def score(self) -> float:
+        """Fraction of checks passed, 0..1 (a run that did not finish scores 0)."""
+        if not self.checks or any(run["state"] != RunState.FINISHED for run in self.runs):
+            return 0.0
+        return sum(check.passed for check in self.checks) / len(self.checks)
+
+    def summary(self) -> dict:
+        return {
+            "exercise": self.exercise,
+            "passed": self.passed,
+            "score": round(self.score, 3),
+            "checks": [
+                {
+                    "name": c.name,
+                    "value": c.value,
+                    "threshold": c.threshold,
+                    "comparison": c.comparison,
+                    "unit": c.unit,
+                    "passed": c.passed,
+                    "per_seed": list(c.per_seed),
+                }
+                for c in self.checks
+            ],
+            "runs": list(self.runs),
+        }
+
+
+def reference_nodes(exercise: Exercise) -> tuple[NodeSpec, ...]:
+    return _nodes(exercise, exercise.reference)
+
+
+def starter_nodes(exercise: Exercise) -> tuple[NodeSpec, ...]:
+    return _nodes(exercise, exercise.starter)
+
+
+def _nodes(exercise: Exercise, files: tuple[tuple[str, str], ...]) -> tuple[NodeSpec, ...]:
+    return tuple(NodeSpec.from_file(exercise.code_path(path), name) for name, path in files)
+
+
+def run_spec(exercise: Exercise, nodes: tuple[NodeSpec, ...], seed: int) -> RunSpec:
+    return RunSpec(
+        robot=exercise.robot,
+        world=exercise.world,
+        nodes=nodes,
+        clock=exercise.clock,
+        duration_s=exercise.duration_s,
+        seed=seed,
+        spawn=exercise.spawn,
+        initial_pose=exercise.initial_pose,
+        light_position=exercise.light_position,
+        params=dict(exercise.params),
+        script=tuple((e.time_s, e.action, e.value) for e in exercise.script),
+    )
+
+
+def grade(
+    exercise: Exercise,
+    nodes: tuple[NodeSpec, ...],
+    launcher: Launcher,
+    out_dir: Path | None = None,
+) -> Grade:
+    root = Path(out_dir) if out_dir else Path(tempfile.mkdtemp(prefix=f"check-{exercise.id}-"))
+    per_check: dict[str, list[float]] = {check.name: [] for check in exercise.checks}
+    runs = []
+    for seed in exercise.seeds:
+        run_dir = root / f"seed{seed}"
+        result = Run(run_spec(exercise, nodes, seed), launcher, run_dir).execute()
+        runs.append(
+            {
+                "seed": seed,
+                "state": str(result.state),
+                "reason": result.reason,
+                "run_dir": str(run_dir),
+            }
+        )
+        evidence = load_evidence(result, run_dir)
+        for check in exercise.checks:
+            try:
+                value = float(check.metric(evidence))
+            except (ValueError, KeyError, IndexError, ZeroDivisionError):
+                value = float("nan")  # no data to judge (the run ended early): it fails
+            per_check[check.name].append(value)
+    results = tuple(
+        CheckResult(
+            name=check.name,
+            description=check.description,
+            value=check.comparison.worst(per_check[check.name]),
+            threshold=check.threshold,
+            comparison=str(check.comparison),
+            unit=check.unit,
+            passed=check.comparison.passes(
+                check.comparison.worst(per_check[check.name]), check.threshold
+            ),
+            per_seed=tuple(per_check[check.name]),
+        )
+        for check in exercise.checks
+    )
+    return Grade(exercise.id, results, tuple(runs))

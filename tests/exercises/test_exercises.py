@@ -1,0 +1,75 @@
+"""The exercise registry and grading: every entry valid, every reference solution passes its own
+checks on five seeds, every starter runs and fails at least one check (so the checks can fail)."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import subprocess
+import sys
+
+import pytest
+
+from sandbox import bwrap
+from sandbox.launcher import Launcher
+from server.exercises.grading import grade, reference_nodes, starter_nodes
+from server.exercises.registry import (
+    UnknownExerciseError,
+    exercise_ids,
+    get_exercise,
+    validate_exercise,
+)
+from server.runs.state import RunState
+
+FIVE_SEEDS = (1, 2, 3, 4, 5)
+
+
+@pytest.fixture(scope="module")
+def launcher():
+    problem = bwrap.probe()
+    if problem:
+        pytest.fail(f"the exercise tests need bubblewrap: {problem} (./scripts/test installs it)")
+    launcher = Launcher(pool_size=2)
+    yield launcher
+    launcher.close()
+
+
+@pytest.mark.parametrize("exercise_id", exercise_ids())
+def test_registry_entries_are_valid(exercise_id):
+    assert validate_exercise(get_exercise(exercise_id)) == []
+
+
+def test_unknown_exercise_lists_the_valid_ids():
+    with pytest.raises(UnknownExerciseError, match="crowbot_distance_pid"):
+        get_exercise("crowbot_distnce_pid")
+
+
+@pytest.mark.parametrize("exercise_id", exercise_ids())
+def test_reference_passes_on_five_seeds(exercise_id, launcher, tmp_path):
+    exercise = dataclasses.replace(get_exercise(exercise_id), seeds=FIVE_SEEDS)
+    result = grade(exercise, reference_nodes(exercise), launcher, tmp_path)
+    failed = [(c.name, c.per_seed, c.threshold) for c in result.checks if not c.passed]
+    assert result.passed, (failed, [r["reason"] for r in result.runs])
+
+
+@pytest.mark.parametrize("exercise_id", exercise_ids())
+def test_starter_runs_and_fails_a_check(exercise_id, launcher, tmp_path):
+    exercise = get_exercise(exercise_id)
+    result = grade(exercise, starter_nodes(exercise), launcher, tmp_path)
+    assert all(run["state"] == RunState.FINISHED for run in result.runs), result.runs
+    assert not all(check.passed for check in result.checks)
+
+
+def test_check_command_grades_and_sets_the_exit_code(tmp_path):
+    command = [sys.executable, "-m", "server.cli", "check", "crowbot_distance_pid"]
+    passed = subprocess.run([*command, "--reference"], capture_output=True, text=True, timeout=120)
+    assert passed.returncode == 0, passed.stderr
+    lines = passed.stdout.strip().splitlines()
+    assert lines[0].startswith("pass  settling_time")
+    assert json.loads(lines[-1])["passed"] is True
+    failed = subprocess.run([*command, "--starter"], capture_output=True, text=True, timeout=120)
+    assert failed.returncode == 1
+    assert "FAIL  steady_state_error" in failed.stdout
+    nothing = subprocess.run(command, capture_output=True, text=True, timeout=60)
+    assert nothing.returncode == 2
+    assert "--node FILE [...], --reference or --starter" in nothing.stderr
