@@ -110,7 +110,7 @@ def test_light_arena_lamp_is_movable_and_0_6_m_from_the_centre() -> None:
     world = load_world("light_arena")
     (lamp,) = world.lights
     centre = world.spawn()
-    assert lamp.name == "lamp" and lamp.movable and lamp.intensity == 1.0
+    assert lamp.name == "lamp" and lamp.movable and lamp.intensity == 3.0  # a desk lamp
     assert math.hypot(lamp.x - centre.x, lamp.y - centre.y) == pytest.approx(0.6)
     assert (centre.x, centre.y) == (1.0, 1.0)
 
