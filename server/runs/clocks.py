@@ -70,9 +70,9 @@ def run_lockstep(run: Run) -> None:
 
 def _next_event_ns(run: Run) -> int:
     candidates = [run.duration_ns]
-    scripted = run.next_script_ns()
-    if scripted is not None:
-        candidates.append(scripted)
+    for upcoming in (run.next_script_ns(), run.next_builtin_ns()):
+        if upcoming is not None:
+            candidates.append(upcoming)
     spinning = False
     for slot in run.slots.values():
         if slot.done:
@@ -130,10 +130,10 @@ class RealtimeDriver:
             for s in order
             if not s.done and s.process is not None and s.process.state == "running"
         ]
-        scripted = run.next_script_ns()
+        upcoming = [t for t in (run.next_script_ns(), run.next_builtin_ns()) if t is not None]
         next_ns = min(
             [run.duration_ns, round(run.sim.next_publication_s() * NS)]
-            + ([scripted] if scripted is not None else [])
+            + upcoming
             + [
                 s.wake_at_ns
                 for s in order

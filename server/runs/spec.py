@@ -62,6 +62,7 @@ class RunSpec:
     params: dict[str, object] = field(default_factory=dict)  # rospy.get_param values
     # Scripted controls: (run time [s], action, value), e.g. (10.0, "light", ("lamp", 1.5, 1)).
     script: tuple[tuple[float, str, object], ...] = ()
+    builtin_nodes: tuple[str, ...] = ()  # trusted helpers: map_server, localization, ...
 
     def validate(self) -> None:
         """Raise RunSpecError naming the first problem found."""
@@ -104,6 +105,13 @@ class RunSpec:
             if len(node.code.encode()) > MAX_CODE_BYTES:
                 raise RunSpecError(
                     f"node '{node.name}' is larger than {MAX_CODE_BYTES // 1024} KiB of code"
+                )
+        from server.runs.builtin import BUILTIN_NODES
+
+        for name in self.builtin_nodes:
+            if name not in BUILTIN_NODES:
+                raise RunSpecError(
+                    f"unknown built-in node '{name}'; built-in nodes: {', '.join(BUILTIN_NODES)}"
                 )
         for time_s, action, _ in self.script:
             if not (isinstance(time_s, (int, float)) and 0 <= time_s <= self.duration_s):
