@@ -153,7 +153,10 @@ def _cmd_check(args: argparse.Namespace) -> int:
         nodes = starter_nodes(exercise)
     else:
         nodes = _node_specs(args.node)
-    launcher = Launcher(pool_size=len(nodes), unsafe_no_sandbox=args.unsafe_no_sandbox)
+    # Every seed's nodes start together, warm, while the first run is being set up.
+    launcher = Launcher(
+        pool_size=len(nodes) * len(exercise.seeds), unsafe_no_sandbox=args.unsafe_no_sandbox
+    )
     try:
         result = grade(exercise, nodes, launcher, Path(args.out) if args.out else None)
     finally:

@@ -4,6 +4,7 @@ recording, and judge each check by its worst seed."""
 from __future__ import annotations
 
 import tempfile
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -92,6 +93,7 @@ def run_spec(exercise: Exercise, nodes: tuple[NodeSpec, ...], seed: int) -> RunS
         light_position=exercise.light_position,
         params=dict(exercise.params),
         script=tuple((e.time_s, e.action, e.value) for e in exercise.script),
+        builtin_nodes=exercise.builtin_nodes,
     )
 
 
@@ -102,26 +104,30 @@ def grade(
     out_dir: Path | None = None,
 ) -> Grade:
     root = Path(out_dir) if out_dir else Path(tempfile.mkdtemp(prefix=f"check-{exercise.id}-"))
-    per_check: dict[str, list[float]] = {check.name: [] for check in exercise.checks}
-    runs = []
-    for seed in exercise.seeds:
+
+    def one_seed(seed: int) -> tuple[dict, dict[str, float]]:
         run_dir = root / f"seed{seed}"
         result = Run(run_spec(exercise, nodes, seed), launcher, run_dir).execute()
-        runs.append(
-            {
-                "seed": seed,
-                "state": str(result.state),
-                "reason": result.reason,
-                "run_dir": str(run_dir),
-            }
-        )
         evidence = load_evidence(result, run_dir)
+        values = {}
         for check in exercise.checks:
             try:
-                value = float(check.metric(evidence))
+                values[check.name] = float(check.metric(evidence))
             except (ValueError, KeyError, IndexError, ZeroDivisionError):
-                value = float("nan")  # no data to judge (the run ended early): it fails
-            per_check[check.name].append(value)
+                values[check.name] = float("nan")  # nothing to judge (the run ended early)
+        summary = {
+            "seed": seed,
+            "state": str(result.state),
+            "reason": result.reason,
+            "run_dir": str(run_dir),
+        }
+        return summary, values
+
+    # Seeds are independent runs: run them side by side (their nodes are separate processes).
+    with ThreadPoolExecutor(max_workers=len(exercise.seeds)) as pool:
+        outcomes = list(pool.map(one_seed, exercise.seeds))
+    runs = [summary for summary, _ in outcomes]
+    per_check = {c.name: [values[c.name] for _, values in outcomes] for c in exercise.checks}
     results = tuple(
         CheckResult(
             name=check.name,
