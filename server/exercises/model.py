@@ -77,6 +77,7 @@ class Exercise:
     initial_pose: tuple[float, float, float] | None = None
     light_position: tuple[float, float] | None = None
     script: tuple[ScriptEvent, ...] = ()
+    builtin_nodes: tuple[str, ...] = ()  # trusted helpers (server/runs/builtin.py)
     params: dict[str, object] = field(default_factory=dict)
 
     def code_path(self, relative: str) -> Path:
