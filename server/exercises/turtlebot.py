@@ -21,7 +21,7 @@ from server.exercises.model import Check, Comparison, Exercise
 WAYPOINTS = ((3.0, 3.1, 0.0), (6.0, 1.4, -math.pi / 2), (6.8, 4.6, math.pi / 2))
 WAYPOINT_TOLERANCE_M = 0.25  # [m] as the `waypoints` node counts a goal reached
 LATERAL_RMS_M = 0.10  # [m] RMS distance of the true path from the plan being followed
-FINISH_TIME_S = 45.0  # [s] the last waypoint reached by then (the reference: ~36 s)
+FINISH_TIME_S = 42.0  # [s] the last waypoint reached by then (the reference: ~36 s)
 
 
 def _distance_to_polyline(points: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
@@ -101,7 +101,7 @@ TURTLEBOT_STANLEY = Exercise(
         "T_1 and a lookahead point T_2 on the path give the heading and lateral errors (eq. "
         "5.1-5.6), and w = f_s k_1 gamma_F (eq. 5.7). Return (v, w) for cmd_vel."
     ),
-    duration_s=50.0,
+    duration_s=44.0,
     seeds=(1, 2),
     spawn="start",
     builtin_nodes=("map_server", "localization", "waypoints", "planner"),

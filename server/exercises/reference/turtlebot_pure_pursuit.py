@@ -16,7 +16,7 @@ import numpy as np
 RATE_HZ = 10  # [Hz]
 SUBSCRIBE = ["plan", "pose"]
 
-LOOKAHEAD_M = 0.4  # [m] L
+LOOKAHEAD_M = 0.25  # [m] L: longer cuts the door corners into the walls
 SMOOTHING_WINDOW = 7  # [cells] moving average over the planner's cell centres (0.35 m)
 CRUISE_M_S = 0.3  # [m/s]
 MIN_SPEED_M_S = 0.05  # [m/s] close to the goal, so the robot still arrives
