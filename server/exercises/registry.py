@@ -3,12 +3,15 @@
 from __future__ import annotations
 
 from server.exercises.crowbot import EXERCISES as CROWBOT
+from server.exercises.ir_scout import EXERCISES as IR_SCOUT
 from server.exercises.model import Exercise
 from server.exercises.turtlebot import EXERCISES as TURTLEBOT
 from server.runs.spec import RunSpecError
 from server.sim import load_world, robot_ids, world_ids
 
-_EXERCISES: dict[str, Exercise] = {exercise.id: exercise for exercise in (*CROWBOT, *TURTLEBOT)}
+_EXERCISES: dict[str, Exercise] = {
+    exercise.id: exercise for exercise in (*CROWBOT, *IR_SCOUT, *TURTLEBOT)
+}
 
 
 class UnknownExerciseError(ValueError):
