@@ -35,7 +35,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from server.sim.geometry import distance_to_nearest, offsets_from_segments, segment_arrays
-from server.sim.raycast_few import Circle, Segment, cast_few
+from server.sim.raycast_few import (
+    Circle,
+    Segment,
+    cast_few,
+    clearance_few,
+    penetrations_few,
+)
 from server.sim.world import World
 
 _PARALLEL_EPS = 1e-12  # [m^2] |cross(d, e)| below this: ray parallel to the segment, no hit
@@ -48,6 +54,7 @@ _TWO_PI = 2.0 * math.pi
 _DENSE_MAX_PAIRS = 4000
 # Up to this many ray x surface pairs, a plain Python loop beats numpy's per-call overhead.
 _FEW_MAX_PAIRS = 160
+_FEW_MAX_SURFACES = 64  # contact queries below this many surfaces go through raycast_few
 
 
 @dataclass(frozen=True, slots=True)
@@ -125,6 +132,8 @@ class Obstacles:
                 [self.segment_start, self.segment_vector, self.segment_normal, self.segment_height]
             ).tolist()
         ]
+        # Contact queries in plain Python pay off up to this many surfaces.
+        self._few_surfaces = len(segments) + len(circles) <= _FEW_MAX_SURFACES
         self._few_circles = [
             Circle(x, y, r * r, h)
             for x, y, r, h in np.column_stack(
@@ -376,6 +385,14 @@ class Obstacles:
         each overlapping surface, `angle` (P,) the world-frame direction from the centre to each
         touching surface [rad]. Empty arrays when nothing touches.
         """
+        if self._few_surfaces:
+            few = penetrations_few(
+                self._few_segments, self._few_circles, centre_x, centre_y, radius_m
+            )
+            if not few:
+                return np.zeros((0, 2)), np.zeros(0)
+            push = np.array(few)
+            return push, np.arctan2(-push[:, 1], -push[:, 0])
         centre = np.array([centre_x, centre_y])
         pushes: list[np.ndarray] = []
         away, gap = self._away_from_segments(centre)
@@ -398,6 +415,8 @@ class Obstacles:
 
     def clearance(self, x: float, y: float) -> float:
         """Distance [m] from the point (x, y) to the nearest surface (inf in an empty world)."""
+        if self._few_surfaces:
+            return clearance_few(self._few_segments, self._few_circles, x, y)
         return distance_to_nearest(
             np.array([x, y]),
             (self.segment_start, self.segment_vector, self.segment_length_sq),

@@ -1,4 +1,5 @@
-"""Ray casts of a few rays in plain Python: the ultrasonic cone (7 rays), the IR beam (3 rays).
+"""Geometry of small worlds in plain Python: ray casts of a few rays (the ultrasonic cone, the IR
+beam) and the disc contact queries a physics tick makes while the robot touches something.
 
 Every numpy call costs about a microsecond before it does any work, so the batched cast in
 `obstacles.py` spends ~100-250 us on a 7-ray cast against a handful of walls, most of it in
@@ -6,7 +7,9 @@ call overhead; the same 28 ray-segment tests written as a Python loop take ~20 u
 ultrasonic ranger samples 20 times a second in every run, so this matters when twenty realtime
 runs share one interpreter. The arithmetic and the tie-breaking are those of
 `Obstacles._cast_dense` (first minimum over segments, then circles, a circle only wins when
-strictly closer), and the tests compare the two.
+strictly closer), and the tests compare the two. The same holds for contacts: a robot resting
+against a wall needs a contact query every physics tick, ~185 us each through numpy (5k steps/s)
+against ~10 us here.
 """
 
 from __future__ import annotations
@@ -84,3 +87,43 @@ def cast_few(
         distances.append(best)
         cosines.append(best_cos)
     return distances, cosines
+
+
+def _closest_on_segment(seg: Segment, x: float, y: float) -> tuple[float, float]:
+    """Vector from the closest point of `seg` to (x, y)."""
+    rel_x, rel_y = x - seg.start_x, y - seg.start_y
+    length_sq = max(seg.edge_x * seg.edge_x + seg.edge_y * seg.edge_y, 1e-18)
+    along = min(1.0, max(0.0, (rel_x * seg.edge_x + rel_y * seg.edge_y) / length_sq))
+    return rel_x - along * seg.edge_x, rel_y - along * seg.edge_y
+
+
+def penetrations_few(
+    segments: list[Segment], circles: list[Circle], x: float, y: float, radius_m: float
+) -> list[tuple[float, float]]:
+    """Push-out vectors for every surface a disc of `radius_m` at (x, y) overlaps (segments
+    first, then circles, as `Obstacles.penetrations` orders them)."""
+    pushes = []
+    for seg in segments:
+        away_x, away_y = _closest_on_segment(seg, x, y)
+        gap = math.hypot(away_x, away_y)
+        if gap < radius_m:
+            gap = max(gap, 1e-9)
+            pushes.append((away_x / gap * (radius_m - gap), away_y / gap * (radius_m - gap)))
+    for circle in circles:
+        away_x, away_y = x - circle.x, y - circle.y
+        gap = math.hypot(away_x, away_y)
+        overlap = radius_m + math.sqrt(circle.radius_sq) - gap
+        if overlap > 0.0:
+            gap = max(gap, 1e-9)
+            pushes.append((away_x / gap * overlap, away_y / gap * overlap))
+    return pushes
+
+
+def clearance_few(segments: list[Segment], circles: list[Circle], x: float, y: float) -> float:
+    """Distance [m] from (x, y) to the nearest surface (inf in an empty world)."""
+    nearest = math.inf
+    for seg in segments:
+        nearest = min(nearest, math.hypot(*_closest_on_segment(seg, x, y)))
+    for circle in circles:
+        nearest = min(nearest, math.hypot(x - circle.x, y - circle.y) - math.sqrt(circle.radius_sq))
+    return nearest
