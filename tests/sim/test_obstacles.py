@@ -243,3 +243,20 @@ def test_few_ray_cast_with_circles_and_heights() -> None:
         few = obstacles.cast(np.array(origin), angles, 3.0, min_height)
         dense = obstacles._cast_dense(np.array(origin), angles, 3.0, min_height)
         np.testing.assert_allclose(few.distance_m, dense.distance_m, atol=1e-12)
+
+
+@pytest.mark.parametrize("world_id", ["wall_approach", "obstacle_maze", "office"])
+def test_contact_queries_agree_between_python_and_numpy(world_id: str) -> None:
+    fast = Obstacles(load_world(world_id))
+    batched = Obstacles(load_world(world_id))
+    batched._few_surfaces = False  # force the numpy path
+    rng = np.random.default_rng(5)
+    for _ in range(400):
+        x, y = rng.uniform([-0.2, -0.2], [8.0, 6.0])
+        radius = float(rng.uniform(0.05, 0.3))
+        assert fast.clearance(x, y) == pytest.approx(batched.clearance(x, y), abs=1e-12)
+        push_fast, angle_fast = fast.penetrations(x, y, radius)
+        push_numpy, angle_numpy = batched.penetrations(x, y, radius)
+        np.testing.assert_allclose(push_fast, push_numpy, atol=1e-12)
+        # Compare directions, not numbers: -pi and pi are the same way (a signed zero apart).
+        np.testing.assert_allclose(np.angle(np.exp(1j * (angle_fast - angle_numpy))), 0, atol=1e-9)
