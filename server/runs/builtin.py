@@ -9,6 +9,9 @@ localization come from Nav2; the student writes the controller).
   (PoseStamped), the next one each time the robot comes within `waypoint_tolerance_m`.
 - `planner`: a path on `plan` (nav_msgs/Path) from the robot to each new `goal_pose`, by A* over
   the map with obstacles grown by the robot's radius, as Nav2's NavFn plans on its costmap.
+- `teleop`: drives the robot from key presses (`Run.teleop(key, pressed)`: up/down/left/right,
+  as arrow keys in the browser), publishing a Twist on the robot's velocity topic at 10 Hz while
+  a key is held and one zero Twist when all are released.
 
 They run in the server process (no sandbox: they are our code), are called synchronously by
 the run, and publish through the same topic bus, so students see them as ordinary nodes.
@@ -221,6 +224,41 @@ def astar(
     return []
 
 
+TELEOP_SPEED_M_S = 0.1  # [m/s] forward/backward while an arrow key is held
+TELEOP_TURN_RAD_S = 1.0  # [rad/s] left/right while an arrow key is held
+TELEOP_KEYS = ("up", "down", "left", "right")
+
+
+class Teleop(BuiltinNode):
+    name = "teleop"
+    rate_hz = 10.0  # [Hz] a held key repeats, as a keyboard does
+
+    def start(self, run: Run) -> list[tuple[str, object]]:
+        from sandbox.msgs.geometry_msgs import Twist
+
+        self.twist_class = Twist
+        self.topic = run.velocity_topic
+        if self.topic is None:
+            raise ValueError(f"robot '{run.spec.robot}' has no velocity topic to drive")
+        self.held: set[str] = set()
+        self.was_moving = False
+        return []
+
+    def key(self, key: str, pressed: bool) -> None:
+        if key not in TELEOP_KEYS:
+            raise ValueError(f"teleop knows the keys {', '.join(TELEOP_KEYS)}, not '{key}'")
+        (self.held.add if pressed else self.held.discard)(key)
+
+    def tick(self, run: Run) -> list[tuple[str, object]]:
+        if not self.held and not self.was_moving:
+            return []
+        twist = self.twist_class()
+        twist.linear.x = TELEOP_SPEED_M_S * (("up" in self.held) - ("down" in self.held))
+        twist.angular.z = TELEOP_TURN_RAD_S * (("left" in self.held) - ("right" in self.held))
+        self.was_moving = bool(self.held)
+        return [(self.topic, twist)]
+
+
 BUILTIN_NODES: dict[str, type[BuiltinNode]] = {
-    cls.name: cls for cls in (MapServer, Localization, Waypoints, Planner)
+    cls.name: cls for cls in (MapServer, Localization, Waypoints, Planner, Teleop)
 }

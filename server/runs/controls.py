@@ -70,6 +70,14 @@ class RunControls:
             raise ValueError(f"a fault lasts a positive number of seconds, got {duration_s}")
         self._control(("fault", (kind, topic, duration_s)))
 
+    def teleop(self, key: str, pressed: bool) -> None:
+        """An arrow key pressed or released in the browser (needs the `teleop` built-in)."""
+        from server.runs.builtin import TELEOP_KEYS
+
+        if key not in TELEOP_KEYS:
+            raise ValueError(f"teleop knows the keys {', '.join(TELEOP_KEYS)}, not '{key}'")
+        self._control(("teleop", (str(key), bool(pressed))))
+
     def _control(self, action: tuple[str, object]) -> None:
         self._controls.put(action)
         # Wake a realtime loop that sleeps until its next event (see clocks.run_realtime).
@@ -115,6 +123,12 @@ class RunControls:
                 log.info("run %s: light not moved: %s", self.run_id, error)
         elif action == "goal":
             self._publish_goal(*value)
+        elif action == "teleop":
+            teleop = next((b for b in self.builtins if b.name == "teleop"), None)
+            if teleop is None:
+                log.info("run %s: a teleop key, but the run has no teleop node", self.run_id)
+            else:
+                teleop.key(*value)
         elif action == "fault":
             kind, topic, duration_s = value
             kind = FaultKind(kind)

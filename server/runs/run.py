@@ -174,14 +174,7 @@ class Run(RunControls):
             topics.extend(
                 RobotTopic(t, kind, "publish", builtin.rate_hz) for t, kind in builtin.publishes
             )
-        velocity = next(
-            (
-                t.name
-                for t in self.sim.topics
-                if t.direction is Direction.SUBSCRIBE and t.type_name == "geometry_msgs/Twist"
-            ),
-            None,
-        )
+        velocity = self.velocity_topic
         return NodeInfo(
             node_name=node.name,
             robot=self.spec.robot,
@@ -385,6 +378,18 @@ class Run(RunControls):
         self.bus.publish(RUN, envelope, self.time_ns / NS)
         self.recorder.record(GOAL_TOPIC, envelope.type, self.time_ns, envelope.data)
 
+    @property
+    def velocity_topic(self) -> str | None:
+        """The robot's Twist command topic (Control, cmd_vel), if it has one."""
+        return next(
+            (
+                t.name
+                for t in self.sim.topics
+                if t.direction is Direction.SUBSCRIBE and t.type_name == "geometry_msgs/Twist"
+            ),
+            None,
+        )
+
     # ----------------------------------------------------------------------------- built-ins
     @property
     def time_s(self) -> float:
@@ -395,6 +400,8 @@ class Run(RunControls):
             envelope = Envelope(topic, message._type, message.serialize())
             self.bus.publish(builtin.name, envelope, self.time_s)
             self.recorder.record(topic, envelope.type, self.time_ns, envelope.data)
+            if topic in self.sim.robot.commands and not self.faults.motors_stalled():
+                self.sim.apply(topic, message)  # trusted: a rejection is our bug, let it raise
             self._to_builtins(builtin.name, topic, message)
 
     def _to_builtins(self, source: str, topic: str, message: object) -> None:

@@ -15,7 +15,7 @@ from server.sim import load_world, robot_ids, robots_for_world, world_ids
 MAX_DURATION_S = 3600.0  # [s] an hour of simulated time: longer is a mistake, not an exercise
 MAX_NODES = 8  # a launch file larger than this is not a student exercise
 MAX_CODE_BYTES = 256 * 1024  # [bytes] per node file
-SCRIPT_ACTIONS = ("light", "goal", "button", "fault")
+SCRIPT_ACTIONS = ("light", "goal", "button", "fault", "teleop")
 _NODE_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]{0,39}$")
 
 

@@ -72,3 +72,22 @@ def test_unknown_builtin_is_a_sentence():
                    builtin_nodes=("teleporter",))  # fmt: skip
     with pytest.raises(RunSpecError, match="unknown built-in node 'teleporter'"):
         spec.validate()
+
+
+def test_teleop_drives_while_a_key_is_held(tmp_path, launcher):
+    spec = RunSpec(
+        "crowbot",
+        "light_arena",
+        (NodeSpec("idle", "def step(obs):\n    return None\n", "idle.py"),),
+        duration_s=3.0,
+        builtin_nodes=("teleop",),
+        script=((0.5, "teleop", ("up", True)), (1.5, "teleop", ("up", False))),
+    )
+    run = Run(spec, launcher, tmp_path / "run")
+    start_x = 1.0  # light_arena's centre spawn, facing +x
+    result = run.execute()
+    assert result.state is RunState.FINISHED, result.reason
+    moved = run.sim.state.pose.x - start_x
+    assert moved == pytest.approx(0.1, abs=0.015)  # 1 s at 0.1 m/s, less the motor lag
+    with pytest.raises(ValueError, match="teleop knows the keys"):
+        run.teleop("jump", True)
