@@ -124,7 +124,7 @@ class RunControls:
         elif action == "goal":
             self._publish_goal(*value)
         elif action == "teleop":
-            teleop = next((b for b in self.builtins if b.name == "teleop"), None)
+            teleop = self.builtins.get("teleop")
             if teleop is None:
                 log.info("run %s: a teleop key, but the run has no teleop node", self.run_id)
             else:

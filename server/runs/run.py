@@ -27,7 +27,7 @@ from sandbox.msgs.geometry_msgs import Point, Pose, PoseStamped, Quaternion
 from sandbox.msgs.std_msgs import Header
 from sandbox.node_process import NodeProcess
 from sandbox.protocol import Clock, Envelope, Exited, NodeInfo, Outcome, RobotTopic, Yield
-from server.runs.builtin import BUILTIN_NODES
+from server.runs.builtin_host import BuiltinHost
 from server.runs.bus import ROBOT, RUN, TopicBus
 from server.runs.controls import RunControls
 from server.runs.faults import Faults
@@ -97,8 +97,7 @@ class Run(RunControls):
         self._next_tf_ns = 0
         self.clock_wall_s = 0.0  # wall time the clock ran (node start-up excluded)
         self._script = sorted(spec.script, key=lambda event: event[0])
-        self.builtins = [BUILTIN_NODES[name]() for name in spec.builtin_nodes]
-        self._builtin_next_ns: dict[str, int] = {}
+        self.builtins = BuiltinHost(spec.builtin_nodes)
 
     # ----------------------------------------------------------------------------- lifecycle
     def _move(self, new: RunState) -> None:
@@ -170,10 +169,10 @@ class Run(RunControls):
             RobotTopic(t.name, t.type_name, str(t.direction), t.rate_hz) for t in self.sim.topics
         ]
         topics.append(RobotTopic(GOAL_TOPIC, PoseStamped._type, "publish", None))
-        for builtin in self.builtins:
-            topics.extend(
-                RobotTopic(t, kind, "publish", builtin.rate_hz) for t, kind in builtin.publishes
-            )
+        topics.extend(
+            RobotTopic(topic, kind, "publish", rate)
+            for topic, kind, rate in self.builtins.published_topics()
+        )
         velocity = self.velocity_topic
         return NodeInfo(
             node_name=node.name,
@@ -202,17 +201,7 @@ class Run(RunControls):
                 self.bus.declare(slot.name, reply.advertised, reply.subscribed)
         for slot, reply in replies:
             self.handle_reply(slot, reply, timed=False)
-        for builtin in self.builtins:
-            self.bus.add_node(builtin.name)
-            # start() publishes the time-0 message; ticks follow one period later.
-            self._builtin_next_ns[builtin.name] = (
-                round(NS / builtin.rate_hz) if builtin.rate_hz else 0
-            )
-        # Every built-in is ready before any of them publishes (the planner must have its map
-        # when the waypoints node sends the first goal).
-        started = [(builtin, builtin.start(self)) for builtin in self.builtins]
-        for builtin, published in started:
-            self._publish_builtin(builtin, published)
+        self.builtins.start(self)
 
     def _finish(self, end_state: RunState, reason: str, wall_s: float) -> RunResult:
         for slot in self.slots.values():
@@ -331,10 +320,7 @@ class Run(RunControls):
             if self.sim.robot.commands.get(envelope.topic) is not None:
                 self._command_robot(slot, envelope)
             if self.builtins:
-                subscribed = any(envelope.topic in b.subscribes for b in self.builtins)
-                if subscribed:
-                    message = get_message_class(envelope.type).deserialize(envelope.data)
-                    self._to_builtins(slot.name, envelope.topic, message)
+                self.builtins.deliver_envelope(self, slot.name, envelope)
 
     def _command_robot(self, slot: NodeSlot, envelope: Envelope) -> None:
         if self.faults.motors_stalled():
@@ -395,30 +381,8 @@ class Run(RunControls):
     def time_s(self) -> float:
         return self.time_ns / NS
 
-    def _publish_builtin(self, builtin, published: list[tuple[str, object]]) -> None:
-        for topic, message in published:
-            envelope = Envelope(topic, message._type, message.serialize())
-            self.bus.publish(builtin.name, envelope, self.time_s)
-            self.recorder.record(topic, envelope.type, self.time_ns, envelope.data)
-            if topic in self.sim.robot.commands and not self.faults.motors_stalled():
-                self.sim.apply(topic, message)  # trusted: a rejection is our bug, let it raise
-            self._to_builtins(builtin.name, topic, message)
-
-    def _to_builtins(self, source: str, topic: str, message: object) -> None:
-        for builtin in self.builtins:
-            if topic in builtin.subscribes and builtin.name != source:
-                self._publish_builtin(builtin, builtin.on_message(self, topic, message))
-
-    def _tick_builtins(self) -> None:
-        for builtin in self.builtins:
-            if builtin.rate_hz and self._builtin_next_ns[builtin.name] <= self.time_ns:
-                self._builtin_next_ns[builtin.name] = self.time_ns + round(NS / builtin.rate_hz)
-                self._publish_builtin(builtin, builtin.tick(self))
-
     def next_builtin_ns(self) -> int | None:
-        """Run time of the next built-in tick, if any (the clocks stop there)."""
-        ticking = [self._builtin_next_ns[b.name] for b in self.builtins if b.rate_hz]
-        return min(ticking) if ticking else None
+        return self.builtins.next_ns()
 
     # ----------------------------------------------------------------------------- simulation
     def advance_to(self, time_ns: int) -> None:
@@ -438,7 +402,7 @@ class Run(RunControls):
             _, action, value = self._script.pop(0)
             self._apply_control(action, value)
         if self.builtins:
-            self._tick_builtins()
+            self.builtins.tick(self)
         self._check_robot()
         if self.time_ns >= self._next_tf_ns:
             self._record_tf()
