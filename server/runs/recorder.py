@@ -43,7 +43,6 @@ import json
 import logging
 import math
 import os
-import re
 import threading
 from collections.abc import Iterable, Mapping
 from enum import StrEnum
@@ -53,6 +52,7 @@ from typing import IO, Any
 from mcap.writer import CompressionType, Writer
 
 from sandbox.msgs import Message, get_message_class
+from server.runs.safe_paths import inside, safe_name, safe_relative_path
 
 log = logging.getLogger(__name__)
 
@@ -66,10 +66,6 @@ _ENTRY_OVERHEAD_BYTES = 128  # [B] a tuple + int + topic ref in CPython; bounds 
 _WRITER_WAKE_BYTES = 1024 * 1024  # [B] wake the writer early once this much waits (one chunk)
 _WRITER_POLL_S = 0.05  # [s] otherwise the writer drains what has gathered every 50 ms
 _CLOSE_TIMEOUT_S = 60.0  # [s] a writer that cannot finish in this long is declared failed
-_MAX_NAME_CHARS = 100  # [chars] per path component of a log or artifact name
-_MAX_ARTIFACT_DEPTH = 8  # [dirs] sub-directories kept from an artifact name
-
-_UNSAFE_CHARS = re.compile(r"[^\w.\-]+")
 
 
 class RecorderState(StrEnum):
@@ -86,37 +82,6 @@ def mcap_topic(name: str) -> str:
     """The MCAP/ROS topic name of a bus topic: ``scan`` -> ``/scan`` (ROS tools expect the
     leading slash)."""
     return name if name.startswith("/") else "/" + name
-
-
-def _path_parts(name: str) -> list[str]:
-    """The parts of `name` split at "/" and "\\", without empty, "." and ".." parts."""
-    return [part for part in re.split(r"[/\\]+", str(name)) if part not in ("", ".", "..")]
-
-
-def safe_name(name: str) -> str:
-    """One path component made from `name`: "." and ".." parts are dropped, separators and
-    other unsafe characters become "_", leading/trailing dots go; never empty."""
-    parts = _path_parts(name)
-    cleaned = _UNSAFE_CHARS.sub("_", "_".join(parts)).strip(".")
-    return cleaned[:_MAX_NAME_CHARS] or "_"
-
-
-def safe_relative_path(name: str) -> Path:
-    """A relative path made from an artifact name: sub-directories are kept, but "..", ".",
-    empty parts and a leading "/" are dropped, so 'a/../../b' -> 'a/b', '/etc/x' -> 'etc/x'."""
-    parts = _path_parts(name)
-    if not parts:
-        return Path("_")
-    kept = parts[-(_MAX_ARTIFACT_DEPTH + 1) :]
-    return Path(*(safe_name(part) for part in kept))
-
-
-def _inside(root: Path, relative: Path) -> Path:
-    """`root / relative`, checked to resolve inside `root` (symlinks included)."""
-    target = root / relative
-    if not target.resolve().is_relative_to(root.resolve()):
-        raise ValueError(f"refusing to write {relative}: it resolves outside {root}")
-    return target
 
 
 def _json_safe(value: Any) -> Any:
@@ -339,9 +304,9 @@ class Recorder:
         root = self.out_dir / ARTIFACTS_DIR
         written = []
         try:
-            node_dir = _inside(root, Path(safe_name(node)))
+            node_dir = inside(root, Path(safe_name(node)))
             for name, data in files:
-                target = _inside(node_dir, safe_relative_path(name))
+                target = inside(node_dir, safe_relative_path(name))
                 target.parent.mkdir(parents=True, exist_ok=True)
                 target.write_bytes(data)
                 written.append(target)
@@ -471,7 +436,7 @@ class Recorder:
             handle = self._log_files.get(node)
             if handle is None:
                 logs_dir.mkdir(parents=True, exist_ok=True)
-                path = _inside(logs_dir, Path(f"{node}.log"))
+                path = inside(logs_dir, Path(f"{node}.log"))
                 handle = open(path, "a", encoding="utf-8")  # noqa: SIM115  # closed at the end
                 self._log_files[node] = handle
                 self._paths["logs"] = str(logs_dir)

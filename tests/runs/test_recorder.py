@@ -23,9 +23,8 @@ from server.runs.recorder import (
     Recorder,
     RecorderClosedError,
     RecorderState,
-    safe_name,
-    safe_relative_path,
 )
+from server.runs.safe_paths import safe_name, safe_relative_path
 from server.runs.tf import tf_message
 from server.sim import Simulation
 
