@@ -155,7 +155,8 @@ def _cmd_check(args: argparse.Namespace) -> int:
         nodes = _node_specs(args.node)
     # Every seed's nodes start together, warm, while the first run is being set up.
     launcher = Launcher(
-        pool_size=len(nodes) * len(exercise.seeds), unsafe_no_sandbox=args.unsafe_no_sandbox
+        pool_size=len(nodes) * max(len(exercise.seeds), len(exercise.starts)),
+        unsafe_no_sandbox=args.unsafe_no_sandbox,
     )
     try:
         result = grade(exercise, nodes, launcher, Path(args.out) if args.out else None)

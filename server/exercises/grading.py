@@ -80,7 +80,12 @@ def _nodes(exercise: Exercise, files: tuple[tuple[str, str], ...]) -> tuple[Node
     return tuple(NodeSpec.from_file(exercise.code_path(path), name) for name, path in files)
 
 
-def run_spec(exercise: Exercise, nodes: tuple[NodeSpec, ...], seed: int) -> RunSpec:
+def run_spec(
+    exercise: Exercise,
+    nodes: tuple[NodeSpec, ...],
+    seed: int,
+    initial_pose: tuple[float, float, float] | None = None,
+) -> RunSpec:
     return RunSpec(
         robot=exercise.robot,
         world=exercise.world,
@@ -89,7 +94,7 @@ def run_spec(exercise: Exercise, nodes: tuple[NodeSpec, ...], seed: int) -> RunS
         duration_s=exercise.duration_s,
         seed=seed,
         spawn=exercise.spawn,
-        initial_pose=exercise.initial_pose,
+        initial_pose=initial_pose or exercise.initial_pose,
         light_position=exercise.light_position,
         params=dict(exercise.params),
         script=tuple((e.time_s, e.action, e.value) for e in exercise.script),
@@ -105,9 +110,10 @@ def grade(
 ) -> Grade:
     root = Path(out_dir) if out_dir else Path(tempfile.mkdtemp(prefix=f"check-{exercise.id}-"))
 
-    def one_seed(seed: int) -> tuple[dict, dict[str, float]]:
-        run_dir = root / f"seed{seed}"
-        result = Run(run_spec(exercise, nodes, seed), launcher, run_dir).execute()
+    def one_run(case: tuple[int, int, tuple[float, float, float] | None]):
+        index, seed, start = case
+        run_dir = root / f"run{index}-seed{seed}"
+        result = Run(run_spec(exercise, nodes, seed, start), launcher, run_dir).execute()
         evidence = load_evidence(result, run_dir)
         values = {}
         for check in exercise.checks:
@@ -117,15 +123,26 @@ def grade(
                 values[check.name] = float("nan")  # nothing to judge (the run ended early)
         summary = {
             "seed": seed,
+            "start": list(start) if start else None,
             "state": str(result.state),
             "reason": result.reason,
             "run_dir": str(run_dir),
         }
         return summary, values
 
-    # Seeds are independent runs: run them side by side (their nodes are separate processes).
-    with ThreadPoolExecutor(max_workers=len(exercise.seeds)) as pool:
-        outcomes = list(pool.map(one_seed, exercise.seeds))
+    # One run per seed, or per start pose (seeds taken in turn); independent runs go side by
+    # side (their nodes are separate processes).
+    seeds = exercise.seeds
+    if exercise.starts:
+        count = max(len(exercise.starts), len(seeds))
+        cases = [
+            (i, seeds[i % len(seeds)], exercise.starts[i % len(exercise.starts)])
+            for i in range(count)
+        ]
+    else:
+        cases = [(i, seed, None) for i, seed in enumerate(seeds)]
+    with ThreadPoolExecutor(max_workers=len(cases)) as pool:
+        outcomes = list(pool.map(one_run, cases))
     runs = [summary for summary, _ in outcomes]
     per_check = {c.name: [values[c.name] for _, values in outcomes] for c in exercise.checks}
     results = tuple(

@@ -75,6 +75,8 @@ class Exercise:
     clock: Clock = Clock.LOCKSTEP
     spawn: str | None = None
     initial_pose: tuple[float, float, float] | None = None
+    # Several start poses (x, y, yaw): one graded run each, seeds taken in turn from `seeds`.
+    starts: tuple[tuple[float, float, float], ...] = ()
     light_position: tuple[float, float] | None = None
     script: tuple[ScriptEvent, ...] = ()
     builtin_nodes: tuple[str, ...] = ()  # trusted helpers (server/runs/builtin.py)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from server.exercises.crop_rover import EXERCISES as CROP_ROVER
 from server.exercises.crowbot import EXERCISES as CROWBOT
 from server.exercises.ir_scout import EXERCISES as IR_SCOUT
 from server.exercises.model import Exercise
@@ -10,7 +11,7 @@ from server.runs.spec import RunSpecError
 from server.sim import load_world, robot_ids, world_ids
 
 _EXERCISES: dict[str, Exercise] = {
-    exercise.id: exercise for exercise in (*CROWBOT, *IR_SCOUT, *TURTLEBOT)
+    exercise.id: exercise for exercise in (*CROP_ROVER, *CROWBOT, *IR_SCOUT, *TURTLEBOT)
 }
 
 

@@ -12,6 +12,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
+from sandbox.msgs.geometry_msgs import Twist, Vector3
 from sandbox.msgs.sensor_msgs import LaserScan
 from sandbox.msgs.std_msgs import Float32
 from server.sim import Pose2D, Simulation
@@ -144,8 +145,12 @@ def drive(module, duration_s: float, spawn: Pose2D | None = None, seed: int = 0)
     times, poses = [], []
     for _ in range(round(duration_s * module.RATE_HZ)):
         obs = SimpleNamespace(scan=sim.read("scan"), psi=sim.read("psi"), time=sim.time_s)
-        u = module.step(obs)["u"]
-        sim.apply("u", Float32(data=float(u)))
+        command = module.step(obs)
+        if "u" in command:
+            sim.apply("u", Float32(data=float(command["u"])))
+        else:  # the starter stops at a row end with a zero Twist
+            v, w = command["cmd_vel"]
+            sim.apply("cmd_vel", Twist(linear=Vector3(x=v), angular=Vector3(z=w)))
         pose = sim.state.pose
         times.append(sim.time_s)
         poses.append((pose.x, pose.y, pose.yaw))

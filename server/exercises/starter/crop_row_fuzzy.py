@@ -56,5 +56,7 @@ def step(obs):
     scan = obs.scan
     l_m = lateral_distance(scan.ranges, scan.angle_min, scan.angle_increment, obs.psi.data, psi_d)
     if l_m is None:
-        return {"u": 0.0}  # TODO: a gap in the row, or the row's end (section 2.3)
+        # TODO: a gap in the row, or the row's end (section 2.3): turn into the next path.
+        # Until then, stop here rather than drive off the field.
+        return {"cmd_vel": (0.0, 0.0)}
     return {"u": control_action(l_m)}
