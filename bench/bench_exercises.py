@@ -20,7 +20,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=3)
     args = parser.parse_args()
-    print(f"{'exercise':<24} {'seeds':>5} {'sim s':>6} {'wall p50':>9} {'wall max':>9}  result")
+    print(f"{'exercise':<24} {'runs':>5} {'sim s':>6} {'wall p50':>9} {'wall max':>9}  result")
     for exercise_id in exercise_ids():
         exercise = get_exercise(exercise_id)
         walls, verdict = [], "?"
@@ -34,9 +34,10 @@ def main() -> None:
             )
             walls.append(time.perf_counter() - started)
             verdict = "pass" if done.returncode == 0 else f"FAIL ({done.returncode})"
+        runs = max(len(exercise.seeds), len(exercise.starts))  # one run per seed or start pose
         print(
-            f"{exercise_id:<24} {len(exercise.seeds):>5} "
-            f"{exercise.duration_s * len(exercise.seeds):>6.0f} "
+            f"{exercise_id:<24} {runs:>5} "
+            f"{exercise.duration_s * runs:>6.0f} "
             f"{statistics.median(walls):>8.2f}s {max(walls):>8.2f}s  {verdict}"
         )
 
