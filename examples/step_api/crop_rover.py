@@ -2,6 +2,7 @@
 
 Topics: psi (std_msgs/Float32, yaw [rad]) in; u (std_msgs/Float32, -100..100, negative steers
 left) and cmd_vel out. The first command drives forward; then u corrects the heading.
+Paper: 001_8d7ab1b8a58c0603.txt section 2.1 (psi from the BNO055, the control word u).
 """
 
 import math

@@ -1,6 +1,7 @@
 """CrowBot, step API: drive forward, stop 20 cm before an obstacle, LEDs red while stopped.
 
 Topics: Distance (std_msgs/Int32, cm; 0 = no echo) in, Control (Twist) and Leds out.
+Paper: 000_32b6074bbd2115c3.txt section 2.3 and Table 1 (the firmware's topics).
 """
 
 from std_msgs.msg import Int32MultiArray

@@ -2,6 +2,7 @@
 
 Topics: ir_range (sensor_msgs/Range, metres; inf when nothing is in range) in; motor_command
 (std_msgs/String: forward, backward, left, right, stop) out.
+Paper: 002_3fcfeb7b4c14107a.txt section II (IR ranger, motor directions of Fig. 14).
 """
 
 RATE_HZ = 10  # [Hz]

@@ -2,6 +2,7 @@
 
 Topics: scan (sensor_msgs/LaserScan from the depth camera, 0.3-3 m) and bumper
 (std_msgs/Int32MultiArray [left, right]) in; cmd_vel (Twist) out via a (v, w) pair.
+Paper: 003_4f92d1fa0a49ddae.txt sections 3.3-3.4 and 5 (depth scan, Roomba base).
 """
 
 import numpy as np
