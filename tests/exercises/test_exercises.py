@@ -10,8 +10,6 @@ import sys
 
 import pytest
 
-from sandbox import bwrap
-from sandbox.launcher import Launcher
 from server.exercises.grading import grade, reference_nodes, starter_nodes
 from server.exercises.registry import (
     UnknownExerciseError,
@@ -22,16 +20,6 @@ from server.exercises.registry import (
 from server.runs.state import RunState
 
 FIVE_SEEDS = (1, 2, 3, 4, 5)
-
-
-@pytest.fixture(scope="module")
-def launcher():
-    problem = bwrap.probe()
-    if problem:
-        pytest.fail(f"the exercise tests need bubblewrap: {problem} (./scripts/test installs it)")
-    launcher = Launcher(pool_size=2)
-    yield launcher
-    launcher.close()
 
 
 @pytest.mark.parametrize("exercise_id", exercise_ids())

@@ -11,8 +11,6 @@ import math
 import numpy as np
 import pytest
 
-from sandbox import bwrap
-from sandbox.launcher import Launcher
 from server.exercises import turtlebot
 from server.exercises.grading import grade
 from server.exercises.model import EXERCISE_DIR
@@ -96,16 +94,6 @@ def test_distance_to_polyline():
     path = np.array([(0.0, 0.0), (1.0, 0.0)])
     distances = turtlebot._distance_to_polyline(path, np.array([0.5, 2.0]), np.array([0.1, 0.0]))
     assert np.allclose(distances, (0.1, 1.0))
-
-
-@pytest.fixture(scope="module")
-def launcher():
-    problem = bwrap.probe()
-    if problem:
-        pytest.fail(f"the exercise tests need bubblewrap: {problem} (./scripts/test installs it)")
-    launcher = Launcher(pool_size=1)
-    yield launcher
-    launcher.close()
 
 
 def test_pure_pursuit_also_reaches_every_waypoint(launcher, tmp_path):

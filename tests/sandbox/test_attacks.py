@@ -226,8 +226,9 @@ def test_killing_the_parent_is_impossible(launcher):
         exited = finish(
             launcher, "import os, signal\nos.kill(os.getppid(), signal.SIGKILL)\nos.kill(1, 9)\n"
         )
-    assert exited.outcome in (Outcome.FINISHED, Outcome.ERROR, Outcome.CRASHED)
-    assert os.getpid() > 0  # this process (the server's stand-in) is still here
+    # Inside its pid namespace the parent is bwrap's init, which ignores the signal: the node
+    # ends normally, and the Bystander above proved the server side kept stepping.
+    assert exited.outcome is Outcome.FINISHED, exited
 
 
 def test_ctypes_raw_syscalls_are_filtered(launcher):
