@@ -47,7 +47,7 @@ class BuiltinHost:
         for topic, message in published:
             envelope = Envelope(topic, message._type, message.serialize())
             run.bus.publish(node.name, envelope, run.time_s)
-            run.recorder.record(topic, envelope.type, run.time_ns, envelope.data)
+            run.record(topic, envelope.type, run.time_ns, envelope.data)
             if topic in run.sim.robot.commands and not run.faults.motors_stalled():
                 run.sim.apply(topic, message)  # trusted: a rejection is our bug, let it raise
             self.deliver(run, node.name, topic, message)

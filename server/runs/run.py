@@ -1,6 +1,6 @@
 """A run: a robot backend, one or more sandboxed nodes, a clock, a topic bus and a recording.
 
-    run = Run(spec, launcher, out_dir)
+    run = Run(spec, launcher, out_dir, observer=hub)   # observer: optional, see RunObserver
     result = run.execute()          # blocking: call it from a worker thread or the CLI
     run.stop() / run.pause() / run.press_button(True) / ...   # from any thread, meanwhile
 
@@ -20,6 +20,7 @@ import uuid
 from collections import deque
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Protocol
 
 from sandbox.launcher import Launcher
 from sandbox.msgs import Time, get_message_class
@@ -50,6 +51,18 @@ MAP_MARGIN_M = 0.5  # [m] beyond the world's bounds by this much, the robot left
 LOG_LINES_KEPT = 2000  # per node in memory (the recording keeps them all)
 
 
+class RunObserver(Protocol):
+    """Watches a run live (the web service's telemetry hub). Called on the run's own thread,
+    so each method must be quick and must not raise; what it does with the data (coalescing,
+    dropping for slow viewers) is its business, never the run's."""
+
+    def on_message(self, topic: str, type_name: str, time_ns: int, data: bytes) -> None: ...
+
+    def on_logs(self, node: str, lines: list[str]) -> None: ...
+
+    def on_state(self, state: RunState, reason: str, time_s: float) -> None: ...
+
+
 @dataclass
 class NodeSlot:
     """The run's view of one node."""
@@ -77,8 +90,10 @@ class Run(RunControls):
         launcher: Launcher,
         out_dir: str | Path,
         run_id: str | None = None,
+        observer: RunObserver | None = None,
     ) -> None:
         spec.validate()
+        self.observer = observer
         self.spec = spec
         self.launcher = launcher
         self.run_id = run_id or uuid.uuid4().hex[:12]
@@ -104,6 +119,11 @@ class Run(RunControls):
         with self._state_lock:
             check_transition(self.state, new)
             self.state = new
+        if self.observer is not None:
+            try:
+                self.observer.on_state(new, self.reason, self.time_ns / NS)
+            except Exception:  # a viewer's problem never ends a run
+                log.exception("run %s: the observer failed on a state change", self.run_id)
 
     def execute(self) -> RunResult:
         """Run to the end and return the result. Never raises for anything a node does."""
@@ -282,8 +302,7 @@ class Run(RunControls):
         slot.exited, slot.done = reply, True
         if reply.error is not None:  # the student's traceback belongs in the node's log
             lines = reply.error.traceback.rstrip("\n").split("\n")
-            slot.logs.extend(lines)
-            self.recorder.write_log(slot.name, lines)
+            self._log_lines(slot, lines)
         if reply.outcome is Outcome.FINISHED:
             if all(s.done for s in self.slots.values()):
                 raise RunEnd(RunState.FINISHED, "finished: every node ended")
@@ -316,7 +335,7 @@ class Run(RunControls):
         for envelope in published:
             slot.metrics.published += 1
             self.bus.publish(slot.name, envelope, now_s)
-            self.recorder.record(envelope.topic, envelope.type, self.time_ns, envelope.data)
+            self.record(envelope.topic, envelope.type, self.time_ns, envelope.data)
             if self.sim.robot.commands.get(envelope.topic) is not None:
                 self._command_robot(slot, envelope)
             if self.builtins:
@@ -330,16 +349,14 @@ class Run(RunControls):
             self.sim.apply(envelope.topic, message)
         except (SimulationError, CommandError, ValueError) as error:
             slot.metrics.rejected_commands += 1
-            slot.logs.append(f"[robot] rejected {envelope.topic}: {error}")
-            if self.recorder is not None:
-                self.recorder.write_log(slot.name, [f"[robot] rejected {envelope.topic}: {error}"])
+            self._log_lines(slot, [f"[robot] rejected {envelope.topic}: {error}"])
             return
         if slot.newest_sensor_s is not None:
             slot.metrics.latency.add(self.time_ns / NS - slot.newest_sensor_s)
 
     def _from_robot(self, topic: str, message: object, time_s: float) -> None:
         envelope = Envelope(topic, message._type, message.serialize())
-        self.recorder.record(topic, envelope.type, round(time_s * NS), envelope.data)
+        self.record(topic, envelope.type, round(time_s * NS), envelope.data)
         if self.faults.active:
             self.faults.expire(self.time_ns)
             envelope = self.faults.filter(envelope)
@@ -362,7 +379,7 @@ class Run(RunControls):
         )
         envelope = Envelope(GOAL_TOPIC, PoseStamped._type, goal.serialize())
         self.bus.publish(RUN, envelope, self.time_ns / NS)
-        self.recorder.record(GOAL_TOPIC, envelope.type, self.time_ns, envelope.data)
+        self.record(GOAL_TOPIC, envelope.type, self.time_ns, envelope.data)
 
     @property
     def velocity_topic(self) -> str | None:
@@ -434,14 +451,32 @@ class Run(RunControls):
             self.sim.robot.sensor_frames(self.sim.state),
             odom_origin=(origin.x, origin.y, origin.yaw),
         )
-        self.recorder.record("tf", message._type, self.time_ns, message.serialize())
+        self.record("tf", message._type, self.time_ns, message.serialize())
         self._next_tf_ns = self.time_ns + TF_PERIOD_NS
+
+    def record(self, topic: str, type_name: str, time_ns: int, data: bytes) -> None:
+        """One message into the recording and, if someone watches, to the observer."""
+        self.recorder.record(topic, type_name, time_ns, data)
+        if self.observer is not None:
+            try:
+                self.observer.on_message(topic, type_name, time_ns, data)
+            except Exception:
+                log.exception("run %s: the observer failed on a message", self.run_id)
+                self.observer = None  # one report, not one per message
 
     def _collect_logs(self, slot: NodeSlot) -> None:
         if slot.process is None:
             return
         lines = slot.process.logs.take()
         if lines:
-            slot.logs.extend(lines)
-            if self.recorder is not None:
-                self.recorder.write_log(slot.name, lines)
+            self._log_lines(slot, lines)
+
+    def _log_lines(self, slot: NodeSlot, lines: list[str]) -> None:
+        slot.logs.extend(lines)
+        if self.recorder is not None:
+            self.recorder.write_log(slot.name, lines)
+        if self.observer is not None:
+            try:
+                self.observer.on_logs(slot.name, list(lines))
+            except Exception:
+                log.exception("run %s: the observer failed on log lines", self.run_id)
