@@ -4,6 +4,7 @@
     robodojo worlds                       # the worlds, a line each
     robodojo run --robot crowbot --world wall_approach --node examples/step_api/crowbot.py
     robodojo export RUN_DIR               # a CSV per topic from a run's recording
+    robodojo serve                        # the web lab (server/api/serve.py)
 
 `run` executes headless: a progress bar of simulated time on a terminal (plain lines when not a
 TTY), the recording and artifacts written to --out, and one JSON summary as the last line of
@@ -29,6 +30,7 @@ from server.runs.spec import NodeSpec, RunSpec, RunSpecError
 from server.runs.state import RunState
 from server.sim import get_robot, load_world, robot_ids, robots_for_world, world_ids
 from server.sim.world import WorldError
+from server.store.db import StoreError
 
 PROGRESS_WIDTH = 30  # [characters] of the progress bar
 
@@ -242,6 +244,10 @@ def build_parser() -> argparse.ArgumentParser:
     export.add_argument("run_dir", help="the --out folder of a run")
     export.add_argument("--out", default=None, help="folder for the CSV files")
     export.set_defaults(func=_cmd_export)
+
+    from server.api.serve import add_commands
+
+    add_commands(commands)
     return parser
 
 
@@ -249,7 +255,7 @@ def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     try:
         return args.func(args)
-    except (RunSpecError, WorldError, SandboxUnavailable, ValueError) as error:
+    except (RunSpecError, WorldError, SandboxUnavailable, StoreError, ValueError) as error:
         # Our errors are sentences: no traceback for a typo.
         print(f"robodojo: {error}", file=sys.stderr)
         return 2

@@ -3,6 +3,7 @@ recording, and judge each check by its worst seed."""
 
 from __future__ import annotations
 
+import math
 import tempfile
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
@@ -11,6 +12,7 @@ from pathlib import Path
 from sandbox.launcher import Launcher
 from server.exercises.evidence import load_evidence
 from server.exercises.model import Exercise
+from server.runs.result import RunResult
 from server.runs.run import Run
 from server.runs.spec import NodeSpec, RunSpec
 from server.runs.state import RunState
@@ -102,6 +104,41 @@ def run_spec(
     )
 
 
+def check_values(exercise: Exercise, result: RunResult, run_dir: Path) -> dict[str, float]:
+    """Each check's value for one finished run (NaN where the run gave nothing to judge)."""
+    evidence = load_evidence(result, run_dir)
+    values = {}
+    for check in exercise.checks:
+        try:
+            values[check.name] = float(check.metric(evidence))
+        except (ValueError, KeyError, IndexError, ZeroDivisionError):
+            values[check.name] = float("nan")  # nothing to judge (the run ended early)
+    return values
+
+
+def judge_run(exercise: Exercise, result: RunResult, run_dir: Path) -> tuple[list[dict], float]:
+    """One run judged on its own (a student's run from the web): each check's value against
+    its threshold, and the score, the fraction passed (0 when the run did not finish)."""
+    values = check_values(exercise, result, run_dir)
+    checks = []
+    for check in exercise.checks:
+        value = values[check.name]
+        checks.append(
+            {
+                "name": check.name,
+                "description": check.description,
+                "value": value if math.isfinite(value) else None,
+                "threshold": check.threshold,
+                "comparison": str(check.comparison),
+                "unit": check.unit,
+                "passed": check.comparison.passes(value, check.threshold),
+            }
+        )
+    finished = result.state is RunState.FINISHED
+    score = sum(c["passed"] for c in checks) / len(checks) if checks and finished else 0.0
+    return checks, score
+
+
 def grade(
     exercise: Exercise,
     nodes: tuple[NodeSpec, ...],
@@ -114,13 +151,7 @@ def grade(
         index, seed, start = case
         run_dir = root / f"run{index}-seed{seed}"
         result = Run(run_spec(exercise, nodes, seed, start), launcher, run_dir).execute()
-        evidence = load_evidence(result, run_dir)
-        values = {}
-        for check in exercise.checks:
-            try:
-                values[check.name] = float(check.metric(evidence))
-            except (ValueError, KeyError, IndexError, ZeroDivisionError):
-                values[check.name] = float("nan")  # nothing to judge (the run ended early)
+        values = check_values(exercise, result, run_dir)
         summary = {
             "seed": seed,
             "start": list(start) if start else None,

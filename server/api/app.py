@@ -1,0 +1,113 @@
+"""The FastAPI app: the store opened and migrated, runs left active by the last stop marked
+interrupted, a first instructor made (its login link printed, as Jupyter does), the sandbox
+launcher and the run service started; on shutdown every run stopped cleanly.
+
+    app = create_app(Settings())      # `robodojo serve` does this and hands it to uvicorn
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+from pathlib import Path
+
+from fastapi import FastAPI, Request
+from fastapi.responses import FileResponse, HTMLResponse, JSONResponse
+from fastapi.staticfiles import StaticFiles
+
+from sandbox.launcher import Launcher
+from server.api import errors
+from server.api.routes import admin, admin_runs, catalog, live, runs, session, workspaces
+from server.api.settings import Settings
+from server.service.runs import RunService
+from server.store import accounts
+from server.store import runs as run_store
+from server.store.accounts import Role
+from server.store.db import Store
+
+log = logging.getLogger("robodojo.api")
+WEB_DIR = Path(__file__).resolve().parents[2] / "web"
+MAX_BODY_BYTES = 4 * 1024 * 1024  # [B] above every code limit; a bigger body is refused early
+FIRST_INSTRUCTOR = "instructor"
+
+
+def bootstrap(store: Store, settings: Settings) -> str | None:
+    """The first instructor, on an empty database: returns its login URL (printed once)."""
+    with store.session() as db:
+        if accounts.instructors_exist(db):
+            return None
+        made = accounts.create_user(db, FIRST_INSTRUCTOR, Role.INSTRUCTOR)
+    return f"{settings.base_url()}/login?token={made.token}"
+
+
+def create_app(settings: Settings | None = None, launcher: Launcher | None = None) -> FastAPI:
+    settings = settings or Settings()
+
+    @contextlib.asynccontextmanager
+    async def lifespan(app: FastAPI):
+        settings.data.mkdir(parents=True, exist_ok=True)
+        store = Store.open(settings.store_url)
+        with store.session() as db:
+            interrupted = run_store.mark_interrupted(db)
+        if interrupted:
+            log.warning("%d run(s) were active when the server stopped: marked interrupted",
+                        interrupted)  # fmt: skip
+        own_launcher = launcher is None
+        run_launcher = launcher or Launcher(
+            pool_size=settings.sandbox_pool, unsafe_no_sandbox=settings.unsafe_no_sandbox
+        )
+        app.state.settings = settings
+        app.state.store = store
+        app.state.runs = RunService(store, settings, run_launcher)
+        url = bootstrap(store, settings)
+        if url:
+            print(f"RoboDojo: log in as the instructor at {url}", flush=True)
+            print("  (the token in that link also works as 'Authorization: Bearer' for the "
+                  "admin API; keep it secret)", flush=True)  # fmt: skip
+        else:
+            print(f"RoboDojo: serving at {settings.base_url()}/ (for a new instructor login "
+                  "link: robodojo login-url)", flush=True)  # fmt: skip
+        try:
+            yield
+        finally:
+            app.state.runs.shutdown()
+            if own_launcher:
+                run_launcher.close()
+            store.close()
+
+    app = FastAPI(
+        title="RoboDojo",
+        summary="A remote lab for small mobile robots: run Python controllers against "
+        "simulated or real robots.",
+        version="0.1.0",
+        lifespan=lifespan,
+    )
+    app.state.settings = settings
+    errors.install(app)
+
+    @app.middleware("http")
+    async def limit_body(request: Request, call_next):
+        length = request.headers.get("content-length")
+        if length is not None and (not length.isdigit() or int(length) > MAX_BODY_BYTES):
+            return JSONResponse(
+                status_code=413,
+                content={"detail": f"the request body is larger than {MAX_BODY_BYTES} bytes"},
+            )
+        return await call_next(request)
+
+    for module in (session, catalog, workspaces, runs, live, admin, admin_runs):
+        app.include_router(module.router)
+
+    @app.get("/", include_in_schema=False)
+    def index():
+        page = WEB_DIR / "index.html"
+        if page.is_file():
+            return FileResponse(page)
+        return HTMLResponse(
+            "<!doctype html><title>RoboDojo</title><h1>RoboDojo</h1>"
+            "<p>The lab's API is running: see <a href='/docs'>/docs</a>.</p>"
+        )
+
+    if (WEB_DIR / "static").is_dir():
+        app.mount("/static", StaticFiles(directory=WEB_DIR / "static"), name="static")
+    return app

@@ -1,0 +1,84 @@
+"""Every error a client can cause becomes a JSON answer with a sentence in `detail` that says
+what is wrong and what to do. 422 lists the offending fields by path ("body.nodes.0.code");
+404 for an unknown id lists the valid ones; 429 says when to retry. A fault of ours is logged
+with an id and answered 500 with that id, never with a traceback."""
+
+from __future__ import annotations
+
+import logging
+import uuid
+
+from fastapi import FastAPI, Request
+from fastapi.exceptions import RequestValidationError
+from fastapi.responses import JSONResponse
+from starlette.exceptions import HTTPException as StarletteHTTPException
+
+from server.runs.spec import RunSpecError
+from server.service.catalog import UnknownIdError
+from server.service.runs import RunLimitError, RunRequestError
+
+log = logging.getLogger("robodojo.api")
+
+
+def _field_path(location: tuple) -> str:
+    return ".".join(str(part) for part in location)
+
+
+async def _validation(_: Request, error: RequestValidationError) -> JSONResponse:
+    problems = []
+    for item in error.errors():
+        problems.append(
+            {"field": _field_path(item.get("loc", ())), "message": str(item.get("msg", ""))}
+        )
+    first = problems[0] if problems else {"field": "request", "message": "invalid"}
+    more = f" (and {len(problems) - 1} more problem(s))" if len(problems) > 1 else ""
+    return JSONResponse(
+        status_code=422,
+        content={"detail": f"{first['field']}: {first['message']}{more}", "errors": problems},
+    )
+
+
+async def _http(_: Request, error: StarletteHTTPException) -> JSONResponse:
+    return JSONResponse(
+        status_code=error.status_code,
+        content={"detail": error.detail},
+        headers=getattr(error, "headers", None),
+    )
+
+
+async def _unknown_id(_: Request, error: UnknownIdError) -> JSONResponse:
+    return JSONResponse(status_code=404, content={"detail": str(error), "valid": error.valid})
+
+
+async def _run_limit(_: Request, error: RunLimitError) -> JSONResponse:
+    return JSONResponse(
+        status_code=429,
+        content={"detail": str(error), "retry_after_s": error.retry_after_s},
+        headers={"Retry-After": str(error.retry_after_s)},
+    )
+
+
+async def _bad_run(_: Request, error: Exception) -> JSONResponse:
+    return JSONResponse(status_code=422, content={"detail": str(error)})
+
+
+async def _internal(request: Request, error: Exception) -> JSONResponse:
+    incident = uuid.uuid4().hex[:8]
+    log.exception("incident %s: %s %s failed", incident, request.method, request.url.path)
+    return JSONResponse(
+        status_code=500,
+        content={
+            "detail": f"the server hit a fault of its own (incident {incident}); it is logged. "
+            "Try again; if it persists, tell your instructor the incident number."
+        },
+    )
+
+
+def install(app: FastAPI) -> None:
+    app.add_exception_handler(RequestValidationError, _validation)
+    app.add_exception_handler(StarletteHTTPException, _http)
+    app.add_exception_handler(UnknownIdError, _unknown_id)
+    app.add_exception_handler(RunLimitError, _run_limit)
+    app.add_exception_handler(RunRequestError, _bad_run)
+    app.add_exception_handler(RunSpecError, _bad_run)
+    app.add_exception_handler(Exception, _internal)

@@ -1,0 +1,193 @@
+"""`/api/runs/{id}/live`: one websocket per viewer of a run.
+
+Server -> client frames (JSON):
+    {"type": "snapshot", "state", "reason", "time_s", "topics": {name: type}}   first
+    {"type": "telemetry", "topic", "msg_type", "time_s", "msg": {...}, "dropped": n}
+    {"type": "log", "node", "line"} / {"type": "state", "state", "reason", "time_s"}
+    {"type": "checks", "checks": [...], "score"}                                 exercises
+    {"type": "dropped", "what": "events", "count": n}                            fell behind
+    {"type": "ack", "id"} / {"type": "error", "id", "detail"}                    answers
+    {"type": "end", "state", "reason"}                                           then close
+
+Client -> server commands, each answered with an ack or an error carrying its "id":
+    {"id": 1, "op": "subscribe", "topic": "Distance", "max_rate_hz": 20}
+    {"op": "unsubscribe", "topic"} / {"op": "stop"} / {"op": "pause"} / {"op": "resume"}
+    {"op": "button", "pressed": true} / {"op": "light", "x", "y", "name"?}
+    {"op": "goal", "x", "y", "yaw"?} / {"op": "teleop", "key": "up", "pressed": true}
+
+Latest wins: a slow client gets the newest sample at its rate and a count of what it missed;
+nothing queues per client beyond one frame in flight. Someone else's run: closed with code
+4404, as if it did not exist.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import json
+import math
+import time
+
+from fastapi import APIRouter, WebSocket, WebSocketDisconnect
+from starlette.concurrency import run_in_threadpool
+
+from server.api.auth import websocket_user
+from server.service.telemetry import SubscriptionError, UnknownRunError, ViewerLimitError
+from server.store import runs as run_store
+
+router = APIRouter()
+NOT_FOUND_CODE = 4404  # websocket close code: no such run, or not yours
+COMMANDS_PER_S = 50  # a person clicking and typing; more is a runaway client
+MAX_COMMAND_CHARS = 4096  # a command is a small JSON object
+WAIT_S = 1.0  # [s] the writer wakes at least this often to notice a closed socket
+
+
+class CommandError(ValueError):
+    pass
+
+
+def _number(command: dict, key: str, default: float | None = None) -> float:
+    value = command.get(key, default)
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        raise CommandError(f"'{key}' must be a finite number, got {value!r}")
+    return float(value)
+
+
+def _apply(op: str, command: dict, viewer, active) -> None:
+    """Do one command; raise CommandError with a sentence when it cannot be done."""
+    if op == "subscribe":
+        viewer.subscribe(command.get("topic"), command.get("max_rate_hz", 10))
+        return
+    if op == "unsubscribe":
+        viewer.unsubscribe(command.get("topic"))
+        return
+    if active is None:
+        raise CommandError(f"the run has ended; '{op}' needs a running run")
+    run = active.run
+    if op == "stop":
+        run.stop("stopped by the user")
+    elif op == "pause":
+        run.pause()
+    elif op == "resume":
+        run.resume()
+    elif op == "button":
+        run.press_button(bool(command.get("pressed", True)))
+    elif op == "light":
+        name = command.get("name")
+        if name is None:
+            movable = [light.name for light in run.sim.lights if light.movable] if run.sim else []
+            if not movable:
+                raise CommandError("this world has no light that can be moved")
+            name = movable[0]
+        run.move_light(str(name), _number(command, "x"), _number(command, "y"))
+    elif op == "goal":
+        run.set_goal(_number(command, "x"), _number(command, "y"), _number(command, "yaw", 0.0))
+    elif op == "teleop":
+        run.teleop(str(command.get("key")), bool(command.get("pressed", True)))
+    else:
+        raise CommandError(
+            f"unknown op {op!r}; ops: subscribe, unsubscribe, stop, pause, resume, button, "
+            "light, goal, teleop"
+        )
+
+
+@router.websocket("/api/runs/{run_id}/live")
+async def live(websocket: WebSocket, run_id: str) -> None:
+    app = websocket.app
+    caller = await run_in_threadpool(websocket_user, websocket)
+    record = None
+    if caller is not None and len(run_id) <= 64:
+
+        def lookup():
+            with app.state.store.session() as db:
+                return run_store.get(db, run_id)
+
+        record = await run_in_threadpool(lookup)
+    await websocket.accept()
+    if record is None or (record.user_id != caller.id and not caller.is_instructor):
+        reason = "not logged in" if caller is None else "no such run (or it is not yours)"
+        await websocket.close(code=NOT_FOUND_CODE, reason=reason)
+        return
+    service = app.state.runs
+    try:
+        telemetry = service.telemetry.get(run_id)
+        viewer = telemetry.viewer()
+    except (UnknownRunError, ViewerLimitError) as error:
+        # Ended long ago (or too many viewers): what the store knows, then the end.
+        await websocket.send_json(
+            {
+                "type": "snapshot",
+                "state": record.state,
+                "reason": record.reason,
+                "topics": {},
+                "time_s": record.sim_time_s,
+                "note": str(error),
+            }
+        )
+        if record.checks:
+            await websocket.send_json(
+                {"type": "checks", "checks": record.checks, "score": record.score}
+            )
+        await websocket.send_json({"type": "end", "state": record.state, "reason": record.reason})
+        await websocket.close()
+        return
+    send_lock = asyncio.Lock()
+
+    async def send(frame: dict) -> None:
+        async with send_lock:
+            await websocket.send_text(json.dumps(frame, allow_nan=False, default=str))
+
+    async def reader() -> None:
+        window_start, count = time.monotonic(), 0
+        while True:
+            text = await websocket.receive_text()
+            now = time.monotonic()
+            if now - window_start >= 1.0:
+                window_start, count = now, 0
+            count += 1
+            request_id = None
+            try:
+                if count > COMMANDS_PER_S:
+                    raise CommandError(f"more than {COMMANDS_PER_S} commands a second; slow down")
+                if len(text) > MAX_COMMAND_CHARS:
+                    raise CommandError(f"a command is at most {MAX_COMMAND_CHARS} characters")
+                try:
+                    command = json.loads(text)
+                except ValueError:
+                    raise CommandError('a command is a JSON object, e.g. {"op": "stop"}') from None
+                if not isinstance(command, dict):
+                    raise CommandError('a command is a JSON object, e.g. {"op": "stop"}')
+                request_id = command.get("id")
+                if not isinstance(request_id, str | int | None) or isinstance(request_id, bool):
+                    request_id = None
+                    raise CommandError("'id' must be a string or an integer")
+                _apply(str(command.get("op")), command, viewer, service.active(run_id))
+            except (CommandError, SubscriptionError, ValueError, TypeError) as error:
+                await send({"type": "error", "id": request_id, "detail": str(error)})
+            else:
+                await send({"type": "ack", "id": request_id})
+
+    async def writer() -> None:
+        await send(telemetry.snapshot())
+        while not viewer.finished:
+            for frame in await viewer.next_frames(WAIT_S):
+                await send(frame)
+        final = telemetry.snapshot()
+        await send({"type": "end", "state": final["state"], "reason": final["reason"]})
+
+    tasks = [asyncio.create_task(reader()), asyncio.create_task(writer())]
+    try:
+        done, _ = await asyncio.wait(tasks, return_when=asyncio.FIRST_COMPLETED)
+        for task in done:
+            error = task.exception()
+            if error is not None and not isinstance(error, WebSocketDisconnect | RuntimeError):
+                raise error
+    finally:
+        for task in tasks:
+            task.cancel()
+        for task in tasks:
+            with contextlib.suppress(BaseException):
+                await task
+        viewer.close()
+        with contextlib.suppress(Exception):
+            await websocket.close()

@@ -1,0 +1,293 @@
+"""Runs: start one, list mine, look at one, stop/pause/resume it, and download what it left:
+the MCAP recording, a CSV per topic, the logs and the files the code saved.
+
+A run that is not the caller's is answered 404, exactly as one that does not exist
+(instructors see every run)."""
+
+from __future__ import annotations
+
+import json
+import threading
+from datetime import UTC, datetime
+from pathlib import Path
+
+from fastapi import APIRouter, Depends, HTTPException, Query, Request
+from fastapi.responses import FileResponse, PlainTextResponse
+
+from sandbox.protocol import Clock
+from server.api.auth import Caller, current_user
+from server.api.schemas import RunCommand, RunCreate
+from server.runs.export import csv_file_name, export_csv
+from server.runs.recorder import ARTIFACTS_DIR, LOGS_DIR, RECORDING_FILE
+from server.runs.safe_paths import inside, safe_relative_path
+from server.service import catalog, exercises
+from server.service.runs import RunRequest, RunService
+from server.store import runs as run_store
+from server.store.models import RunRecord
+
+router = APIRouter(prefix="/api/runs", tags=["runs"])
+NOT_FOUND = "no such run (or it is not yours)"
+_csv_lock = threading.Lock()  # one export per run at a time
+
+
+def iso(epoch: float | None) -> str | None:
+    return datetime.fromtimestamp(epoch, UTC).isoformat() if epoch is not None else None
+
+
+def run_out(record: RunRecord, service: RunService) -> dict:
+    active = service.active(record.id)
+    out = {
+        "id": record.id,
+        "user_id": record.user_id,
+        "exercise": record.exercise_id,
+        "robot": record.robot,
+        "world": record.world,
+        "clock": record.clock,
+        "duration_s": record.duration_s,
+        "seed": record.seed,
+        "state": str(active.run.state) if active else record.state,
+        "reason": record.reason,
+        "created_at": iso(record.created_at),
+        "started_at": iso(record.started_at),
+        "ended_at": iso(record.ended_at),
+        "time_s": active.run.time_s if active else record.sim_time_s,
+        "wall_s": record.wall_s,
+        "metrics": record.metrics,
+        "nodes": record.nodes,
+        "checks": record.checks,
+        "score": record.score,
+        "links": {
+            "self": f"/api/runs/{record.id}",
+            "live": f"/api/runs/{record.id}/live",
+            "recording": f"/api/runs/{record.id}/recording.mcap",
+            "logs": f"/api/runs/{record.id}/logs",
+            "artifacts": f"/api/runs/{record.id}/artifacts",
+            "csv": f"/api/runs/{record.id}/csv",
+        },
+    }
+    if active is not None:
+        out["nodes_live"] = {
+            name: {"period": slot.metrics.summary().get("period")}
+            for name, slot in active.run.slots.items()
+        }
+    return out
+
+
+def visible_run(request: Request, caller: Caller, run_id: str) -> RunRecord:
+    with request.app.state.store.session() as db:
+        record = run_store.get(db, run_id)
+    if record is None or (record.user_id != caller.id and not caller.is_instructor):
+        raise HTTPException(404, NOT_FOUND)
+    return record
+
+
+def service_of(request: Request) -> RunService:
+    return request.app.state.runs
+
+
+@router.post("", status_code=201, summary="Start a run (an exercise, or a robot in a world)")
+def create(body: RunCreate, request: Request, caller: Caller = Depends(current_user)) -> dict:
+    service = service_of(request)
+    entry = None
+    if body.exercise is not None:
+        with request.app.state.store.session() as db:
+            entry = exercises.find(db, body.exercise)
+        if body.robot not in (None, entry.exercise.robot) or body.world not in (
+            None,
+            entry.exercise.world,
+        ):
+            raise HTTPException(
+                422,
+                f"exercise '{entry.exercise.id}' uses robot '{entry.exercise.robot}' in world "
+                f"'{entry.exercise.world}'; leave robot and world out",
+            )
+    else:
+        if body.robot is None or body.world is None:
+            raise HTTPException(
+                422, "give an exercise, or a robot and a world: {robot, world, nodes}"
+            )
+        catalog.check_robot(body.robot)
+        catalog.check_world(body.world)
+    request_ = RunRequest(
+        robot=body.robot,
+        world=body.world,
+        exercise=entry,
+        nodes=tuple((node.name, node.code) for node in body.nodes),
+        clock=Clock(body.clock) if body.clock else None,
+        duration_s=body.duration,
+        seed=body.seed,
+    )
+    record = service.start(caller.id, request_)
+    return run_out(record, service)
+
+
+@router.get("", summary="My runs, newest first")
+def listing(
+    request: Request,
+    caller: Caller = Depends(current_user),
+    exercise: str | None = Query(None, max_length=64),
+    limit: int = Query(50, ge=1, le=500),
+    offset: int = Query(0, ge=0),
+) -> dict:
+    where = run_store.RunFilter(user_id=caller.id, exercise_id=exercise, limit=limit, offset=offset)
+    with request.app.state.store.session() as db:
+        rows, total = run_store.listing(db, where)
+    service = service_of(request)
+    return {"total": total, "runs": [run_out(r, service) for r in rows]}
+
+
+@router.get("/{run_id}", summary="One run: state, reason, metrics, periods, checks")
+def one(run_id: str, request: Request, caller: Caller = Depends(current_user)) -> dict:
+    return run_out(visible_run(request, caller, run_id), service_of(request))
+
+
+def _command(request: Request, caller: Caller, run_id: str, action: str, reason: str) -> dict:
+    record = visible_run(request, caller, run_id)
+    active = service_of(request).active(record.id)
+    if active is None:
+        raise HTTPException(409, f"run {run_id} has ended ({record.state}); nothing to {action}")
+    try:
+        if action == "stop":
+            active.run.stop(reason)
+        elif action == "pause":
+            active.run.pause()
+        else:
+            active.run.resume()
+    except ValueError as error:
+        raise HTTPException(409, str(error)) from None
+    return {"ok": True, "id": run_id, "action": action}
+
+
+@router.post("/{run_id}/stop", summary="Stop a run (the robot is commanded to stop)")
+def stop(
+    run_id: str,
+    request: Request,
+    body: RunCommand | None = None,
+    caller: Caller = Depends(current_user),
+) -> dict:
+    who = "an instructor" if caller.is_instructor else "the user"
+    reason = f"stopped by {who}" + (f": {body.reason}" if body and body.reason else "")
+    return _command(request, caller, run_id, "stop", reason)
+
+
+@router.post("/{run_id}/pause", summary="Pause a lockstep run")
+def pause(run_id: str, request: Request, caller: Caller = Depends(current_user)) -> dict:
+    return _command(request, caller, run_id, "pause", "")
+
+
+@router.post("/{run_id}/resume", summary="Resume a paused run")
+def resume(run_id: str, request: Request, caller: Caller = Depends(current_user)) -> dict:
+    return _command(request, caller, run_id, "resume", "")
+
+
+def _run_file(record: RunRecord, relative: str) -> Path:
+    root = Path(record.run_dir)
+    try:
+        path = inside(root, safe_relative_path(relative))
+    except ValueError:
+        raise HTTPException(404, f"no file '{relative}' in this run") from None
+    if not path.is_file():
+        raise HTTPException(404, f"no file '{relative}' in this run")
+    return path
+
+
+@router.get("/{run_id}/recording.mcap", summary="The run's recording (MCAP, ROS1 encoding)")
+def recording(run_id: str, request: Request, caller: Caller = Depends(current_user)):
+    record = visible_run(request, caller, run_id)
+    path = Path(record.run_dir) / RECORDING_FILE
+    if not path.is_file():
+        raise HTTPException(404, "this run has no recording (it failed before it started)")
+    return FileResponse(
+        path, media_type="application/octet-stream", filename=f"robodojo-{run_id}.mcap"
+    )
+
+
+@router.get("/{run_id}/csv", summary="The topics with a CSV file each (after the run ended)")
+def csv_list(run_id: str, request: Request, caller: Caller = Depends(current_user)) -> dict:
+    record = visible_run(request, caller, run_id)
+    folder = _export(request, record)
+    return {
+        "files": [
+            {"name": p.name, "url": f"/api/runs/{run_id}/csv/{p.name}"}
+            for p in sorted(folder.glob("*.csv"))
+        ]
+    }
+
+
+@router.get("/{run_id}/csv/{name}", summary="One topic as CSV")
+def csv_file(run_id: str, name: str, request: Request, caller: Caller = Depends(current_user)):
+    record = visible_run(request, caller, run_id)
+    folder = _export(request, record)
+    wanted = name if name.endswith(".csv") else csv_file_name(name)
+    path = folder / wanted
+    if "/" in wanted or not path.is_file():
+        names = ", ".join(sorted(p.name for p in folder.glob("*.csv")))
+        raise HTTPException(404, f"no CSV '{name}' in this run; its files: {names}")
+    return FileResponse(path, media_type="text/csv", filename=f"{run_id}-{wanted}")
+
+
+def _export(request: Request, record: RunRecord) -> Path:
+    if service_of(request).active(record.id) is not None:
+        raise HTTPException(409, "the run is still going; CSV files are made when it has ended")
+    recording_path = Path(record.run_dir) / RECORDING_FILE
+    if not recording_path.is_file():
+        raise HTTPException(404, "this run has no recording (it failed before it started)")
+    folder = Path(record.run_dir) / "csv"
+    with _csv_lock:
+        if not (folder / ".done").is_file():
+            export_csv(recording_path, folder)
+            (folder / ".done").write_text("")
+    return folder
+
+
+@router.get("/{run_id}/logs", summary="What each node printed")
+def logs(run_id: str, request: Request, caller: Caller = Depends(current_user)) -> dict:
+    record = visible_run(request, caller, run_id)
+    active = service_of(request).active(record.id)
+    if active is not None:
+        return {"nodes": {name: list(slot.logs) for name, slot in active.run.slots.items()}}
+    folder = Path(record.run_dir) / LOGS_DIR
+    nodes = {}
+    if folder.is_dir():
+        for path in sorted(folder.glob("*.log")):
+            nodes[path.stem] = path.read_text("utf-8", errors="replace").splitlines()
+    return {"nodes": nodes}
+
+
+@router.get("/{run_id}/logs/{node}.log", summary="One node's log as text")
+def log_file(run_id: str, node: str, request: Request, caller: Caller = Depends(current_user)):
+    record = visible_run(request, caller, run_id)
+    path = _run_file(record, f"{LOGS_DIR}/{node}.log")
+    return PlainTextResponse(path.read_text("utf-8", errors="replace"))
+
+
+@router.get("/{run_id}/metrics.json", summary="Full metrics with histograms")
+def metrics_file(run_id: str, request: Request, caller: Caller = Depends(current_user)):
+    record = visible_run(request, caller, run_id)
+    path = _run_file(record, "metrics.json")
+    return json.loads(path.read_text("utf-8"))
+
+
+@router.get("/{run_id}/artifacts", summary="Files the nodes saved")
+def artifact_list(run_id: str, request: Request, caller: Caller = Depends(current_user)) -> dict:
+    record = visible_run(request, caller, run_id)
+    folder = Path(record.run_dir) / ARTIFACTS_DIR
+    files = []
+    if folder.is_dir():
+        for path in sorted(p for p in folder.rglob("*") if p.is_file()):
+            name = path.relative_to(folder).as_posix()
+            files.append(
+                {
+                    "name": name,
+                    "bytes": path.stat().st_size,
+                    "url": f"/api/runs/{run_id}/artifacts/{name}",
+                }
+            )
+    return {"files": files}
+
+
+@router.get("/{run_id}/artifacts/{name:path}", summary="One saved file")
+def artifact(run_id: str, name: str, request: Request, caller: Caller = Depends(current_user)):
+    record = visible_run(request, caller, run_id)
+    path = _run_file(record, f"{ARTIFACTS_DIR}/{name}")
+    return FileResponse(path, filename=path.name)

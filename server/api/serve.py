@@ -1,0 +1,102 @@
+"""`robodojo serve` and `robodojo login-url`: the lab as a web service.
+
+    robodojo serve                                  # http://127.0.0.1:8000, data in ./robodojo-data
+    robodojo serve --port 9000 --database-url postgresql://lab@db/robodojo
+    robodojo login-url                              # a new login link for the first instructor
+
+Options override the ROBODOJO_* environment variables, which override the defaults (Settings).
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+
+from server.api.settings import Settings
+
+
+def _settings(args: argparse.Namespace) -> Settings:
+    overrides = {}
+    for key in ("host", "port", "data", "database_url", "public_url"):
+        value = getattr(args, key, None)
+        if value is not None:
+            overrides[key] = value
+    if getattr(args, "unsafe_no_sandbox", False):
+        overrides["unsafe_no_sandbox"] = True
+    return Settings(**overrides)
+
+
+def cmd_serve(args: argparse.Namespace) -> int:
+    import uvicorn
+
+    from sandbox.launcher import Launcher
+    from server.api.app import create_app
+    from server.store.db import Store
+
+    settings = _settings(args)
+    logging.basicConfig(level=logging.INFO, format="%(levelname)s %(name)s: %(message)s")
+    # Fail before uvicorn starts, with our sentence, when the database or sandbox cannot work.
+    Store.open(settings.store_url).close()
+    launcher = Launcher(
+        pool_size=settings.sandbox_pool, unsafe_no_sandbox=settings.unsafe_no_sandbox
+    )
+    try:
+        uvicorn.run(
+            create_app(settings, launcher),
+            host=settings.host,
+            port=settings.port,
+            log_level="info",
+            ws_max_size=1024 * 1024,  # [B] a websocket command is tiny; a megabyte is abuse
+            timeout_graceful_shutdown=int(settings.shutdown_grace_s) + 5,
+        )
+    finally:
+        launcher.close()
+    return 0
+
+
+def cmd_login_url(args: argparse.Namespace) -> int:
+    from server.store import accounts
+    from server.store.accounts import Role
+    from server.store.db import Store
+
+    settings = _settings(args)
+    store = Store.open(settings.store_url)
+    try:
+        with store.session() as db:
+            instructors = [u for u in accounts.list_users(db, Role.INSTRUCTOR) if not u.disabled]
+            if args.name:
+                instructors = [u for u in instructors if u.name == args.name]
+            if not instructors:
+                raise ValueError(
+                    "no such instructor; start the server once (robodojo serve) to create one"
+                )
+            made = accounts.renew_token(db, instructors[0])
+    finally:
+        store.close()
+    print(f"{settings.base_url()}/login?token={made.token}")
+    return 0
+
+
+def _common(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--host", default=None, help="address to listen on (default 127.0.0.1)")
+    parser.add_argument("--port", type=int, default=None, help="port (default 8000)")
+    parser.add_argument("--data", default=None, help="folder for the database and recordings")
+    parser.add_argument("--database-url", default=None, help="postgresql://... (default SQLite)")
+    parser.add_argument("--public-url", default=None, help="how browsers reach this server")
+
+
+def add_commands(commands) -> None:
+    serve = commands.add_parser("serve", help="start the web lab (API, websockets, pages)")
+    _common(serve)
+    serve.add_argument(
+        "--unsafe-no-sandbox",
+        action="store_true",
+        help="DANGER: run student code without bubblewrap (trusted code on a laptop only)",
+    )
+    serve.set_defaults(func=cmd_serve)
+    login = commands.add_parser(
+        "login-url", help="print a new login link for an instructor (the old one stops working)"
+    )
+    _common(login)
+    login.add_argument("--name", default=None, help="which instructor (default: the first)")
+    login.set_defaults(func=cmd_login_url)

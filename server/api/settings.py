@@ -1,0 +1,51 @@
+"""Every setting of the web service in one place. Each can be set by an environment variable
+with the `ROBODOJO_` prefix (ROBODOJO_DATABASE_URL, ROBODOJO_MAX_RUNS_TOTAL, ...) or by the
+`robodojo serve` options; the defaults are the zero-setup embedded lab."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from pydantic import Field
+from pydantic_settings import BaseSettings, SettingsConfigDict
+
+KIB = 1024
+
+
+class Settings(BaseSettings):
+    model_config = SettingsConfigDict(env_prefix="ROBODOJO_", extra="ignore")
+
+    host: str = "127.0.0.1"
+    port: int = Field(8000, ge=0, le=65535)
+    data: Path = Path("robodojo-data")  # SQLite file, recordings, artifacts
+    database_url: str | None = None  # None: SQLite in `data`; else postgresql://...
+    public_url: str | None = None  # how browsers reach us, for printed links (behind a proxy)
+
+    # Limits that protect the lab: value and why.
+    max_runs_per_student: int = Field(2, ge=1)  # two: one running, one being looked at
+    max_runs_total: int = Field(24, ge=1)  # ~a class; each node is a process of ~65 MiB
+    max_run_duration_s: float = Field(600.0, gt=0)  # [s] ten minutes of robot time
+    max_code_bytes_per_file: int = Field(256 * KIB, ge=1)  # [B] far beyond any exercise
+    max_code_bytes_per_run: int = Field(1024 * KIB, ge=1)  # [B] all nodes of one run
+    max_files_per_workspace: int = Field(16, ge=1)
+    retry_after_s: int = Field(10, ge=1)  # [s] told to a client that hit a run limit
+
+    unsafe_no_sandbox: bool = False  # trusted machines only: student code runs unconfined
+    sandbox_pool: int = Field(2, ge=0)  # warm sandbox processes kept ready
+    shutdown_grace_s: float = Field(10.0, gt=0)  # [s] runs get this long to stop cleanly
+
+    @property
+    def runs_dir(self) -> Path:
+        return self.data / "runs"
+
+    @property
+    def store_url(self) -> str:
+        from server.store.db import sqlite_url
+
+        return self.database_url or sqlite_url(self.data)
+
+    def base_url(self) -> str:
+        if self.public_url:
+            return self.public_url.rstrip("/")
+        host = "127.0.0.1" if self.host in ("0.0.0.0", "::", "") else self.host
+        return f"http://{host}:{self.port}"

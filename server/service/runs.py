@@ -1,0 +1,340 @@
+"""The run service: starts runs for users, enforces the lab's limits, keeps the store up to date
+as runs change state, judges exercise runs when they end, and stops everything cleanly at
+shutdown. It knows nothing of HTTP: the API calls it, the CLI could too.
+
+Runs execute in-process, each `Run.execute()` on a worker thread of one pool (the executor seam:
+a distributed worker would replace `_submit`). A run's crash ends that run only: `execute()`
+never raises for what a node does, and anything else is caught here and stored as the reason.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+import uuid
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from sandbox.launcher import Launcher
+from sandbox.protocol import Clock
+from server.exercises.grading import judge_run, run_spec
+from server.runs.result import RunResult
+from server.runs.run import Run
+from server.runs.spec import NodeSpec, RunSpec
+from server.runs.state import RunState
+from server.service.catalog import ExerciseEntry
+from server.service.telemetry import RunTelemetry, TelemetryRegistry
+from server.store import runs as run_store
+from server.store.db import Store
+from server.store.models import RunRecord
+
+log = logging.getLogger("robodojo.service")
+
+
+class RunLimitError(Exception):
+    """Too many runs at once; `retry_after_s` says when to try again."""
+
+    def __init__(self, message: str, retry_after_s: int) -> None:
+        super().__init__(message)
+        self.retry_after_s = retry_after_s
+
+
+class RunRequestError(ValueError):
+    """The run cannot start as asked; the message says what to change."""
+
+
+@dataclass(frozen=True, slots=True)
+class RunRequest:
+    robot: str | None
+    world: str | None
+    exercise: ExerciseEntry | None
+    nodes: tuple[tuple[str, str], ...]  # (name, code)
+    clock: Clock | None
+    duration_s: float | None
+    seed: int | None
+
+
+@dataclass
+class ActiveRun:
+    run: Run
+    user_id: str
+    telemetry: RunTelemetry
+    exercise: ExerciseEntry | None
+    started_wall: float = field(default_factory=time.monotonic)
+
+
+class _Watch:
+    """The run's observer: live viewers get everything, the store gets state changes."""
+
+    def __init__(self, service: RunService, run_id: str, telemetry: RunTelemetry) -> None:
+        self.service = service
+        self.run_id = run_id
+        self.telemetry = telemetry
+        self._end: tuple[RunState, str, float] | None = None
+
+    def on_message(self, topic: str, type_name: str, time_ns: int, data: bytes) -> None:
+        self.telemetry.on_message(topic, type_name, time_ns, data)
+
+    def on_logs(self, node: str, lines: list[str]) -> None:
+        self.telemetry.on_logs(node, lines)
+
+    def on_state(self, state: RunState, reason: str, time_s: float) -> None:
+        if state.is_end:
+            # Viewers hear of the end after the results are stored and the checks judged, so
+            # the check results reach them before the socket closes.
+            self._end = (state, reason, time_s)
+            return
+        try:
+            with self.service.store.session() as db:
+                run_store.set_state(db, self.run_id, str(state))
+        except Exception:
+            log.exception("run %s: could not store state %s", self.run_id, state)
+        self.telemetry.on_state(state, reason, time_s)
+
+    def release_end(self) -> None:
+        state, reason, time_s = self._end or (RunState.FAILED, "failed: the run did not end", 0.0)
+        self.telemetry.on_state(state, reason, time_s)
+
+
+class RunService:
+    def __init__(self, store: Store, settings, launcher: Launcher) -> None:
+        self.store = store
+        self.settings = settings
+        self.launcher = launcher
+        self.telemetry = TelemetryRegistry()
+        self._active: dict[str, ActiveRun] = {}
+        self._lock = threading.Lock()
+        self._closing = False
+        self._pool = ThreadPoolExecutor(
+            max_workers=settings.max_runs_total, thread_name_prefix="run"
+        )
+
+    # ------------------------------------------------------------------------------ starting
+    def build_spec(self, request: RunRequest) -> RunSpec:
+        """The RunSpec a request describes, checked against the lab's limits."""
+        settings = self.settings
+        if not request.nodes:
+            raise RunRequestError("a run needs at least one node: send nodes=[{name, code}]")
+        total = 0
+        for name, code in request.nodes:
+            size = len(code.encode())
+            total += size
+            if size > settings.max_code_bytes_per_file:
+                raise RunRequestError(
+                    f"node '{name}' has {size} bytes of code; the limit per file is "
+                    f"{settings.max_code_bytes_per_file} bytes"
+                )
+        if total > settings.max_code_bytes_per_run:
+            raise RunRequestError(
+                f"the nodes have {total} bytes of code in all; the limit per run is "
+                f"{settings.max_code_bytes_per_run} bytes"
+            )
+        duration = request.duration_s
+        if duration is not None and duration > settings.max_run_duration_s:
+            raise RunRequestError(
+                f"duration {duration:g} s is longer than this lab allows "
+                f"({settings.max_run_duration_s:g} s)"
+            )
+        nodes = tuple(
+            NodeSpec(name=name, code=code, filename=f"{name}.py") for name, code in request.nodes
+        )
+        if request.exercise is not None:
+            exercise = request.exercise.exercise
+            seed = request.seed if request.seed is not None else exercise.seeds[0]
+            start = exercise.starts[0] if exercise.starts else None
+            spec = run_spec(exercise, nodes, seed, start)
+            if duration is not None:  # a shorter try of an exercise is fine; it is judged as is
+                spec = _replace(spec, duration_s=duration)
+            if request.clock is not None:
+                spec = _replace(spec, clock=request.clock)
+        else:
+            spec = RunSpec(
+                robot=request.robot or "",
+                world=request.world or "",
+                nodes=nodes,
+                clock=request.clock or Clock.LOCKSTEP,
+                duration_s=duration if duration is not None else 30.0,
+                seed=request.seed or 0,
+            )
+        spec.validate()  # RunSpecError: the caller turns it into a 422
+        return spec
+
+    def start(self, user_id: str, request: RunRequest) -> RunRecord:
+        spec = self.build_spec(request)
+        with self._lock:
+            if self._closing:
+                raise RunLimitError("the server is shutting down; try again in a minute", 60)
+            mine = sum(1 for a in self._active.values() if a.user_id == user_id)
+            if mine >= self.settings.max_runs_per_student:
+                raise RunLimitError(
+                    f"you already have {mine} runs going (the limit is "
+                    f"{self.settings.max_runs_per_student}); stop one or wait for it to end",
+                    self.settings.retry_after_s,
+                )
+            if len(self._active) >= self.settings.max_runs_total:
+                raise RunLimitError(
+                    f"the lab is running its maximum of {self.settings.max_runs_total} runs; "
+                    f"try again in {self.settings.retry_after_s} s",
+                    self.settings.retry_after_s,
+                )
+            run_id = uuid.uuid4().hex
+            run_dir = Path(self.settings.runs_dir) / run_id
+            exercise = request.exercise
+            record = RunRecord(
+                id=run_id,
+                user_id=user_id,
+                exercise_id=exercise.exercise.id if exercise else None,
+                robot=spec.robot,
+                world=spec.world,
+                clock=str(spec.clock),
+                duration_s=spec.duration_s,
+                seed=spec.seed,
+                state=str(RunState.CREATED),
+                reason="",
+                created_at=time.time(),
+                code=[{"name": n.name, "code": n.code} for n in spec.nodes],
+                metrics={},
+                nodes={},
+                checks=[],
+                run_dir=str(run_dir),
+            )
+            with self.store.session() as db:
+                run_store.add(db, record)
+            telemetry = self.telemetry.create(run_id)
+            run = Run(spec, self.launcher, run_dir, run_id=run_id)
+            run.observer = _Watch(self, run_id, telemetry)
+            self._active[run_id] = ActiveRun(run, user_id, telemetry, exercise)
+        self._pool.submit(self._execute, run_id)
+        return record
+
+    # ------------------------------------------------------------------------------ running
+    def _execute(self, run_id: str) -> None:
+        active = self._active[run_id]
+        run = active.run
+        result: RunResult | None = None
+        try:
+            result = run.execute()
+        except Exception as error:  # execute() should not raise; if it does, this run ends
+            log.exception("run %s raised out of execute()", run_id)
+            reason = f"failed: internal error ({error!r})"
+            self._store_end(run_id, RunState.FAILED, reason, None, active)
+        else:
+            self._store_end(run_id, result.state, result.reason, result, active)
+        finally:
+            with self._lock:
+                self._active.pop(run_id, None)
+            watch = run.observer
+            if isinstance(watch, _Watch):
+                watch.release_end()
+
+    def _store_end(
+        self,
+        run_id: str,
+        state: RunState,
+        reason: str,
+        result: RunResult | None,
+        active: ActiveRun,
+    ) -> None:
+        checks: list[dict] = []
+        score = None
+        if result is not None and active.exercise is not None:
+            try:
+                checks, score = judge_run(active.exercise.exercise, result, active.run.out_dir)
+            except Exception as error:
+                log.exception("run %s: judging failed", run_id)
+                checks = [{"name": "judging", "passed": False, "error": repr(error)}]
+                score = 0.0
+        with self.store.session() as db:
+            record = run_store.get(db, run_id)
+            if record is None:
+                return
+            record.state = str(state)
+            record.reason = reason
+            record.ended_at = time.time()
+            if result is not None:
+                record.sim_time_s = result.duration_s
+                record.wall_s = result.wall_s
+                record.metrics = _finite(result.metrics)
+                record.nodes = _finite(result.summary()["nodes"])
+            record.checks = _finite(checks)
+            record.score = score
+        if checks:
+            active.telemetry.on_event({"type": "checks", "checks": _finite(checks), "score": score})
+
+    # ------------------------------------------------------------------------------ controls
+    def active(self, run_id: str) -> ActiveRun | None:
+        return self._active.get(run_id)
+
+    def active_runs(self) -> list[ActiveRun]:
+        with self._lock:
+            return list(self._active.values())
+
+    def stop(self, run_id: str, reason: str = "stopped by the user") -> bool:
+        """Ask a run to stop; False when it is not running (any more)."""
+        active = self._active.get(run_id)
+        if active is None:
+            return False
+        active.run.stop(reason)
+        return True
+
+    def stop_user(self, user_id: str, reason: str) -> int:
+        stopped = 0
+        for active in self.active_runs():
+            if active.user_id == user_id:
+                active.run.stop(reason)
+                stopped += 1
+        return stopped
+
+    def shutdown(self) -> None:
+        """Stop every run (robots commanded to zero as each ends) and wait for them."""
+        with self._lock:
+            self._closing = True
+            actives = list(self._active.values())
+        for active in actives:
+            active.run.stop("the server is shutting down")
+        deadline = time.monotonic() + self.settings.shutdown_grace_s
+        while self._active and time.monotonic() < deadline:
+            time.sleep(0.05)
+        self._pool.shutdown(wait=False, cancel_futures=True)
+
+    def status(self) -> dict:
+        actives = self.active_runs()
+        return {
+            "active_runs": len(actives),
+            "active_by_state": _count(str(a.run.state) for a in actives),
+            "sandbox_processes": sum(
+                1 for a in actives for slot in a.run.slots.values() if slot.process is not None
+            ),
+            "warm_pool": len(getattr(self.launcher, "_pool", ())),
+            "max_runs_total": self.settings.max_runs_total,
+            "max_runs_per_student": self.settings.max_runs_per_student,
+            "live_viewers": self.telemetry.viewer_count(),
+        }
+
+
+def _replace(spec: RunSpec, **changes) -> RunSpec:
+    from dataclasses import replace
+
+    return replace(spec, **changes)
+
+
+def _count(values) -> dict[str, int]:
+    counts: dict[str, int] = {}
+    for value in values:
+        counts[value] = counts.get(value, 0) + 1
+    return counts
+
+
+def _finite(value):
+    """JSON columns take no NaN/inf (PostgreSQL refuses them): None stands for 'no value'."""
+    import math
+
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if isinstance(value, dict):
+        return {k: _finite(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_finite(v) for v in value]
+    return value

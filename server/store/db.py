@@ -1,0 +1,125 @@
+"""Opening the store: an engine for a SQLite file (the embedded default) or a PostgreSQL URL,
+with the schema brought up to date by Alembic before anything uses it.
+
+    store = Store.open("sqlite:///robodojo-data/robodojo.db")   # or postgresql://...
+    with store.session() as db: ...                              # commits, or rolls back
+
+SQLite serves several threads here (FastAPI's thread pool, run workers): WAL journal so readers
+do not wait for a writer, and a busy timeout so two writers queue instead of failing.
+"""
+
+from __future__ import annotations
+
+import contextlib
+from collections.abc import Iterator
+from pathlib import Path
+
+from sqlalchemy import Engine, create_engine, event, inspect
+from sqlalchemy.engine import make_url
+from sqlalchemy.exc import ArgumentError, OperationalError
+from sqlalchemy.orm import Session, sessionmaker
+
+MIGRATIONS_DIR = Path(__file__).resolve().parent / "migrations"
+SQLITE_BUSY_TIMEOUT_MS = 10_000  # [ms] a writer waits this long for another before failing
+POOL_SIZE = 10  # PostgreSQL connections kept open (FastAPI's thread pool is 40 by default)
+
+
+class StoreError(RuntimeError):
+    """The store cannot be opened or migrated; the message says what to fix."""
+
+
+def normalise_url(url: str) -> str:
+    """`postgresql://` and `postgres://` mean psycopg 3 (the driver we install)."""
+    for prefix in ("postgresql://", "postgres://"):
+        if url.startswith(prefix):
+            return "postgresql+psycopg://" + url[len(prefix) :]
+    return url
+
+
+def sqlite_url(data_dir: str | Path) -> str:
+    return f"sqlite:///{Path(data_dir).resolve() / 'robodojo.db'}"
+
+
+def _sqlite_pragmas(dbapi_connection, _record) -> None:
+    cursor = dbapi_connection.cursor()
+    cursor.execute("PRAGMA journal_mode=WAL")
+    cursor.execute(f"PRAGMA busy_timeout={SQLITE_BUSY_TIMEOUT_MS}")
+    cursor.execute("PRAGMA foreign_keys=ON")
+    cursor.close()
+
+
+def create(url: str) -> Engine:
+    url = normalise_url(url)
+    try:
+        parsed = make_url(url)
+    except ArgumentError:
+        raise StoreError(
+            f"database URL '{url}' is not a URL; use sqlite:///path/to/file.db or "
+            "postgresql://user:password@host:5432/database"
+        ) from None
+    if parsed.get_backend_name() == "sqlite":
+        if parsed.database:
+            Path(parsed.database).parent.mkdir(parents=True, exist_ok=True)
+        engine = create_engine(url, connect_args={"check_same_thread": False})
+        event.listen(engine, "connect", _sqlite_pragmas)
+        return engine
+    if parsed.get_backend_name() != "postgresql":
+        raise StoreError(
+            f"database '{parsed.get_backend_name()}' is not supported; use SQLite (the default) "
+            "or PostgreSQL (postgresql://...)"
+        )
+    return create_engine(url, pool_size=POOL_SIZE, max_overflow=20, pool_pre_ping=True)
+
+
+def migrate(engine: Engine) -> None:
+    """Apply every Alembic migration the database has not seen yet."""
+    from alembic import command
+    from alembic.config import Config
+
+    config = Config()
+    config.set_main_option("script_location", str(MIGRATIONS_DIR))
+    with engine.begin() as connection:
+        config.attributes["connection"] = connection
+        command.upgrade(config, "head")
+
+
+class Store:
+    def __init__(self, engine: Engine) -> None:
+        self.engine = engine
+        self._sessions = sessionmaker(engine, expire_on_commit=False)
+
+    @classmethod
+    def open(cls, url: str) -> Store:
+        engine = create(url)
+        try:
+            migrate(engine)
+        except OperationalError as error:
+            engine.dispose()
+            where = make_url(normalise_url(url)).render_as_string(hide_password=True)
+            raise StoreError(
+                f"cannot open the database at {where}: {error.orig}. Check that the server "
+                "runs and the URL (user, password, host, port, database) is right."
+            ) from None
+        return cls(engine)
+
+    @contextlib.contextmanager
+    def session(self) -> Iterator[Session]:
+        session = self._sessions()
+        try:
+            yield session
+            session.commit()
+        except BaseException:
+            session.rollback()
+            raise
+        finally:
+            session.close()
+
+    @property
+    def dialect(self) -> str:
+        return self.engine.dialect.name
+
+    def tables(self) -> list[str]:
+        return sorted(inspect(self.engine).get_table_names())
+
+    def close(self) -> None:
+        self.engine.dispose()
