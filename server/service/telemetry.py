@@ -136,6 +136,12 @@ class RunTelemetry:
                 self.ended_at_s = time.monotonic()
         self._poke_all()
 
+    def on_event(self, event: dict[str, Any]) -> None:
+        """Any other JSON-able event for viewers (an exercise's check results, say)."""
+        with self._lock:
+            self._append_event(event)
+        self._poke_all()
+
     def _append_event(self, event: dict[str, Any]) -> None:  # with self._lock held
         self._event_seq += 1
         self._events.append(event)
@@ -423,6 +429,11 @@ class TelemetryRegistry:
     def run_ids(self) -> list[str]:
         with self._lock:
             return list(self._runs)
+
+    def viewer_count(self) -> int:
+        """Live viewers over every run."""
+        with self._lock:
+            return sum(telemetry.viewer_count for telemetry in self._runs.values())
 
 
 def latency_summary(latencies_s: Any) -> dict[str, float | int | None]:
