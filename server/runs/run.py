@@ -224,6 +224,7 @@ class Run(RunControls):
         self.builtins.start(self)
 
     def _finish(self, end_state: RunState, reason: str, wall_s: float) -> RunResult:
+        self._command_zero()
         for slot in self.slots.values():
             self._end_node(slot, reason)
         if self.recorder is not None:
@@ -363,6 +364,21 @@ class Run(RunControls):
             if envelope is None:
                 return
         self.bus.publish(ROBOT, envelope, time_s)
+
+    def _command_zero(self) -> None:
+        """Every end (finished, crashed, stopped, server shutdown) leaves the robot commanded
+        to zero velocity, recorded as the run's last command, as a real robot needs."""
+        if self.sim is None or self.recorder is None:
+            return
+        for name, (msg_type, _) in self.sim.robot.commands.items():
+            if msg_type._type != "geometry_msgs/Twist":
+                continue
+            zero = msg_type()
+            try:
+                self.sim.apply(name, zero)
+                self.record(name, msg_type._type, self.time_ns, zero.serialize())
+            except Exception:  # the end must go on whatever the robot says
+                log.exception("run %s: could not command zero velocity on %s", self.run_id, name)
 
     def _stall_motors(self) -> None:
         for name, (msg_type, _) in self.sim.robot.commands.items():

@@ -10,6 +10,7 @@ import time
 import pytest
 from mcap.reader import make_reader
 
+from sandbox.msgs.geometry_msgs import Twist
 from sandbox.protocol import Clock
 from server.runs.faults import FaultKind
 from server.runs.run import Run
@@ -178,7 +179,9 @@ def test_recording_has_every_declared_topic_with_its_schema(tmp_path, launcher):
         topic: len(v) for topic, v in read_recording(tmp_path / "run" / "recording.mcap").items()
     }
     assert counts["/scan"] == pytest.approx(2.0 * 7, abs=1)
-    assert counts["/cmd_vel"] == 20
+    assert counts["/cmd_vel"] == 20 + 1  # the node's 20 commands, then the run's zero at the end
+    _, last_command = read_recording(tmp_path / "run" / "recording.mcap")["/cmd_vel"][-1]
+    assert Twist.deserialize(last_command) == Twist()
 
 
 def test_controls_stop_pause_button_goal_and_faults(tmp_path, launcher):
