@@ -17,7 +17,17 @@ from fastapi.staticfiles import StaticFiles
 
 from sandbox.launcher import Launcher
 from server.api import errors
-from server.api.routes import admin, admin_runs, catalog, live, runs, session, workspaces
+from server.api.routes import (
+    admin,
+    admin_courses,
+    admin_exercises,
+    admin_runs,
+    catalog,
+    live,
+    runs,
+    session,
+    workspaces,
+)
 from server.api.settings import Settings
 from server.service.runs import RunService
 from server.store import accounts
@@ -95,7 +105,8 @@ def create_app(settings: Settings | None = None, launcher: Launcher | None = Non
             )
         return await call_next(request)
 
-    for module in (session, catalog, workspaces, runs, live, admin, admin_runs):
+    for module in (session, catalog, workspaces, runs, live, admin, admin_runs, admin_courses,
+                   admin_exercises):  # fmt: skip
         app.include_router(module.router)
 
     @app.get("/", include_in_schema=False)
