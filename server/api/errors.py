@@ -15,6 +15,7 @@ from starlette.exceptions import HTTPException as StarletteHTTPException
 
 from server.runs.spec import RunSpecError
 from server.service.catalog import UnknownIdError
+from server.service.exercises import ExerciseDefinitionError
 from server.service.runs import RunLimitError, RunRequestError
 
 log = logging.getLogger("robodojo.api")
@@ -62,6 +63,14 @@ async def _bad_run(_: Request, error: Exception) -> JSONResponse:
     return JSONResponse(status_code=422, content={"detail": str(error)})
 
 
+async def _broken_exercise(_: Request, error: Exception) -> JSONResponse:
+    return JSONResponse(
+        status_code=409,
+        content={"detail": f"this exercise cannot be used as stored: {error}. An instructor "
+                 "can fix it (PUT /api/admin/exercises/{id})."},
+    )  # fmt: skip
+
+
 async def _internal(request: Request, error: Exception) -> JSONResponse:
     incident = uuid.uuid4().hex[:8]
     log.exception("incident %s: %s %s failed", incident, request.method, request.url.path)
@@ -81,4 +90,5 @@ def install(app: FastAPI) -> None:
     app.add_exception_handler(RunLimitError, _run_limit)
     app.add_exception_handler(RunRequestError, _bad_run)
     app.add_exception_handler(RunSpecError, _bad_run)
+    app.add_exception_handler(ExerciseDefinitionError, _broken_exercise)
     app.add_exception_handler(Exception, _internal)

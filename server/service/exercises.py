@@ -9,6 +9,7 @@ checks picked from the generic metrics below, each with a threshold.
 from __future__ import annotations
 
 import dataclasses
+import logging
 import time
 
 from sqlalchemy import select
@@ -28,6 +29,8 @@ from server.service.catalog import (
 )
 from server.sim import load_world
 from server.store.models import CustomExercise
+
+log = logging.getLogger("robodojo.service")
 
 
 def _metric(key: str):
@@ -57,9 +60,14 @@ class ExerciseDefinitionError(ValueError):
 
 
 def all_entries(db: Db) -> list[ExerciseEntry]:
+    """Every exercise students can pick; a stored one that no longer builds (its template was
+    removed) is left out and logged, not allowed to break the list for everyone."""
     entries = registry_entries()
     for row in db.scalars(select(CustomExercise).order_by(CustomExercise.id)):
-        entries.append(build(row.definition))
+        try:
+            entries.append(build(row.definition))
+        except (ExerciseDefinitionError, KeyError, ValueError, TypeError) as error:
+            log.warning("custom exercise '%s' is left out: %s", row.id, error)
     return entries
 
 

@@ -91,7 +91,7 @@ def test_student_story(lab):
     topics = {
         channel.topic
         for channel in make_reader(io.BytesIO(recording.content)).get_summary().channels.values()
-    }  # noqa: E501
+    }
     assert {"/Distance", "/Control"} <= topics
     assert student.get(f"/api/runs/{run_id}/logs").json()["nodes"]["driver"]
     assert run_id in [r["id"] for r in student.get("/api/runs").json()["runs"]]

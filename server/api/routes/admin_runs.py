@@ -34,7 +34,7 @@ def all_runs(
     since: datetime | None = Query(None, description="created at or after (ISO 8601)"),
     until: datetime | None = Query(None, description="created before (ISO 8601)"),
     limit: int = Query(100, ge=1, le=500),
-    offset: int = Query(0, ge=0),
+    offset: int = Query(0, ge=0, le=10**9),
 ) -> dict:
     where = run_store.RunFilter(
         user_id=user,

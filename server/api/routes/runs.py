@@ -20,6 +20,7 @@ from server.api.schemas import RunCommand, RunCreate
 from server.runs.export import csv_file_name, export_csv
 from server.runs.recorder import ARTIFACTS_DIR, LOGS_DIR, RECORDING_FILE
 from server.runs.safe_paths import inside, safe_relative_path
+from server.runs.state import RunState
 from server.service import catalog, exercises
 from server.service.runs import RunRequest, RunService
 from server.store import runs as run_store
@@ -34,7 +35,13 @@ def iso(epoch: float | None) -> str | None:
     return datetime.fromtimestamp(epoch, UTC).isoformat() if epoch is not None else None
 
 
-def run_out(record: RunRecord, service: RunService) -> dict:
+def _live_state(state: RunState) -> str:
+    """An ended run still in the service is being judged and stored: its end (with the score)
+    shows once the store has it, so a client never sees 'finished' without its checks."""
+    return str(RunState.STOPPING) if state.is_end else str(state)
+
+
+def run_out(record: RunRecord, service: RunService, with_code: bool = False) -> dict:
     active = service.active(record.id)
     out = {
         "id": record.id,
@@ -45,7 +52,7 @@ def run_out(record: RunRecord, service: RunService) -> dict:
         "clock": record.clock,
         "duration_s": record.duration_s,
         "seed": record.seed,
-        "state": str(active.run.state) if active else record.state,
+        "state": _live_state(active.run.state) if active else record.state,
         "reason": record.reason,
         "created_at": iso(record.created_at),
         "started_at": iso(record.started_at),
@@ -65,6 +72,8 @@ def run_out(record: RunRecord, service: RunService) -> dict:
             "csv": f"/api/runs/{record.id}/csv",
         },
     }
+    if with_code:
+        out["code"] = record.code
     if active is not None:
         out["nodes_live"] = {
             name: {"period": slot.metrics.summary().get("period")}
@@ -127,7 +136,7 @@ def listing(
     caller: Caller = Depends(current_user),
     exercise: str | None = Query(None, max_length=64),
     limit: int = Query(50, ge=1, le=500),
-    offset: int = Query(0, ge=0),
+    offset: int = Query(0, ge=0, le=10**9),
 ) -> dict:
     where = run_store.RunFilter(user_id=caller.id, exercise_id=exercise, limit=limit, offset=offset)
     with request.app.state.store.session() as db:
@@ -138,7 +147,7 @@ def listing(
 
 @router.get("/{run_id}", summary="One run: state, reason, metrics, periods, checks")
 def one(run_id: str, request: Request, caller: Caller = Depends(current_user)) -> dict:
-    return run_out(visible_run(request, caller, run_id), service_of(request))
+    return run_out(visible_run(request, caller, run_id), service_of(request), with_code=True)
 
 
 def _command(request: Request, caller: Caller, run_id: str, action: str, reason: str) -> dict:

@@ -19,6 +19,7 @@ router = APIRouter(prefix="/api/workspaces", tags=["workspaces"])
 FILE_PATTERN = r"^[A-Za-z][A-Za-z0-9_]{0,39}(\.py)?$"
 FileName = Path(pattern=FILE_PATTERN, description="node file: a node name, optionally .py")
 WorkspaceId = Path(max_length=64)
+VersionNumber = Path(ge=1, le=2**31 - 1, description="a version number, from 1")
 
 
 def _starter(request: Request, workspace: str) -> list[tuple[str, str]]:
@@ -116,7 +117,7 @@ def _one_version(request: Request, caller: Caller, workspace: str, filename: str
 @router.get("/{workspace}/files/{filename}/versions/{number}", summary="One saved version")
 def get_version(
     request: Request,
-    number: int,
+    number: int = VersionNumber,
     workspace: str = WorkspaceId,
     filename: str = FileName,
     caller: Caller = Depends(current_user),
@@ -130,7 +131,7 @@ def get_version(
 )
 def restore_version(
     request: Request,
-    number: int,
+    number: int = VersionNumber,
     workspace: str = WorkspaceId,
     filename: str = FileName,
     caller: Caller = Depends(current_user),
