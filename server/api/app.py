@@ -97,6 +97,11 @@ def create_app(settings: Settings | None = None, launcher: Launcher | None = Non
 
     @app.middleware("http")
     async def limit_body(request: Request, call_next):
+        if "\x00" in request.url.path or "%00" in request.url.query:
+            return JSONResponse(
+                status_code=400,
+                content={"detail": "the address holds a NUL character (%00); remove it"},
+            )
         length = request.headers.get("content-length")
         if length is not None and (not length.isdigit() or int(length) > MAX_BODY_BYTES):
             return JSONResponse(

@@ -11,6 +11,7 @@ import uuid
 from fastapi import FastAPI, Request
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
+from sqlalchemy.exc import DataError
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
 from server.runs.spec import RunSpecError
@@ -71,6 +72,17 @@ async def _broken_exercise(_: Request, error: Exception) -> JSONResponse:
     )  # fmt: skip
 
 
+async def _data_error(_: Request, error: DataError) -> JSONResponse:
+    # PostgreSQL refuses some values SQLite takes (a NUL character in text, say): those come
+    # from what the client sent, so they are the client's to change, not a fault of ours.
+    log.info("refused by the database: %s", error.orig)
+    return JSONResponse(
+        status_code=422,
+        content={"detail": "the request holds a value the database cannot store (a NUL "
+                 "character in text, or a number out of range); remove it and try again"},
+    )  # fmt: skip
+
+
 async def _internal(request: Request, error: Exception) -> JSONResponse:
     incident = uuid.uuid4().hex[:8]
     log.exception("incident %s: %s %s failed", incident, request.method, request.url.path)
@@ -91,4 +103,5 @@ def install(app: FastAPI) -> None:
     app.add_exception_handler(RunRequestError, _bad_run)
     app.add_exception_handler(RunSpecError, _bad_run)
     app.add_exception_handler(ExerciseDefinitionError, _broken_exercise)
+    app.add_exception_handler(DataError, _data_error)
     app.add_exception_handler(Exception, _internal)

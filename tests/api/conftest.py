@@ -38,6 +38,29 @@ def step(obs):
 """
 
 
+@dataclass
+class PostgresDatabase:
+    url: str
+    admin: object
+
+    def drop(self) -> None:
+        name = self.url.rsplit("/", 1)[1]
+        self.admin.execute(f'DROP DATABASE IF EXISTS "{name}" WITH (FORCE)')
+        self.admin.close()
+
+
+def create_postgres_database() -> PostgresDatabase:
+    """A new, empty database on the test PostgreSQL (tests/store/conftest.py says where)."""
+    import uuid
+
+    from tests.store.conftest import POSTGRES_URL, _postgres_admin
+
+    admin = _postgres_admin()
+    name = f"robodojo_api_{uuid.uuid4().hex[:10]}"
+    admin.execute(f'CREATE DATABASE "{name}"')
+    return PostgresDatabase(f"{POSTGRES_URL.rsplit('/', 1)[0]}/{name}", admin)
+
+
 def free_port() -> int:
     with socket.socket() as sock:
         sock.bind(("127.0.0.1", 0))
@@ -52,6 +75,7 @@ class LabServer:
     data: Path
     output: list[str] = field(default_factory=list)
     clients: list[httpx.Client] = field(default_factory=list)
+    database_url: str = ""  # the store the server uses, for tests that look behind the API
 
     def client(self, token: str | None = None) -> httpx.Client:
         """A client closed at the end of the test (the `_close_clients` fixture)."""
@@ -126,7 +150,10 @@ def start_server(
     else:
         process.kill()
         raise RuntimeError("the server did not answer in time:\n" + "\n".join(output[-40:]))
-    return LabServer(url, found.get("token", ""), process, data, output)
+    from server.store.db import sqlite_url
+
+    database_url = env.get("ROBODOJO_DATABASE_URL") or sqlite_url(data)
+    return LabServer(url, found.get("token", ""), process, data, output, [], database_url)
 
 
 def stop_server(server: LabServer, timeout_s: float = 30.0) -> int:
@@ -143,12 +170,21 @@ def stop_server(server: LabServer, timeout_s: float = 30.0) -> int:
             server.process.stdout.close()
 
 
-@pytest.fixture(scope="session")
-def lab(tmp_path_factory) -> Iterator[LabServer]:
-    server = start_server(tmp_path_factory.mktemp("lab"))
+@pytest.fixture(scope="session", params=["sqlite", "postgresql"])
+def lab(request, tmp_path_factory) -> Iterator[LabServer]:
+    """The server on its embedded SQLite, then on a fresh PostgreSQL database: every API test
+    runs against both (the PostgreSQL half is skipped, saying why, when none is reachable)."""
+    env = {}
+    database = None
+    if request.param == "postgresql":
+        database = create_postgres_database()
+        env["ROBODOJO_DATABASE_URL"] = database.url
+    server = start_server(tmp_path_factory.mktemp(f"lab-{request.param}"), env)
     assert server.admin_token, "the server printed no login URL:\n" + "\n".join(server.output)
     yield server
     stop_server(server)
+    if database is not None:
+        database.drop()
 
 
 @pytest.fixture(autouse=True)

@@ -14,7 +14,7 @@ from sqlalchemy import delete
 
 from server.exercises.registry import exercise_ids, get_exercise
 from server.service.exercises import GENERIC_CHECKS
-from server.store.db import Store, sqlite_url
+from server.store.db import Store
 from server.store.models import CustomExercise
 from tests.api.conftest import STEP_CONTROLLER, wait_for_end
 
@@ -282,7 +282,7 @@ def test_a_stored_exercise_whose_template_is_gone(lab):
     """A definition stored by an older version, from a built-in exercise since renamed: shown
     with what to do, refused with 409 where it would be used, and repairable."""
     exercise_id = new_id("orphan")
-    store = Store.open(sqlite_url(lab.data))
+    store = Store.open(lab.database_url)
     try:
         with store.session() as db:
             db.add(
