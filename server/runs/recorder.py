@@ -44,6 +44,7 @@ import logging
 import math
 import os
 import threading
+import time
 from collections.abc import Iterable, Mapping
 from enum import StrEnum
 from pathlib import Path
@@ -65,6 +66,7 @@ DEFAULT_MAX_BUFFER_BYTES = 64 * 1024 * 1024  # [B] ~35k LiDAR scans: only a stal
 _ENTRY_OVERHEAD_BYTES = 128  # [B] a tuple + int + topic ref in CPython; bounds tiny messages too
 _WRITER_WAKE_BYTES = 1024 * 1024  # [B] wake the writer early once this much waits (one chunk)
 _WRITER_POLL_S = 0.05  # [s] otherwise the writer drains what has gathered every 50 ms
+CHUNK_FLUSH_S = 1.0  # [s] chunks are closed at least this often: what a crash can lose
 _CLOSE_TIMEOUT_S = 60.0  # [s] a writer that cannot finish in this long is declared failed
 
 
@@ -157,6 +159,7 @@ class Recorder:
         self._log_files: dict[str, IO[str]] = {}
         self._file: IO[bytes] | None = None
         self._writer: Writer | None = None
+        self._last_chunk_flush = time.monotonic()
         self._thread: threading.Thread | None = None
         try:
             self.out_dir.mkdir(parents=True, exist_ok=True)
@@ -426,6 +429,13 @@ class Recorder:
             )
         if batch:
             assert self._file is not None
+            now = time.monotonic()
+            if now - self._last_chunk_flush >= CHUNK_FLUSH_S:
+                # Close the chunk in progress: a crash of the server then loses at most the
+                # last CHUNK_FLUSH_S of messages; the rest reads back (a stream reader reads
+                # an MCAP file without its summary section).
+                writer.flush()
+                self._last_chunk_flush = now
             self._file.flush()
 
     def _write_logs(self, logs: dict[str, list[str]]) -> None:
