@@ -83,6 +83,8 @@ def _apply(op: str, command: dict, viewer, active) -> None:
     elif op == "goal":
         run.set_goal(_number(command, "x"), _number(command, "y"), _number(command, "yaw", 0.0))
     elif op == "teleop":
+        if run.builtins.get("teleop") is None:
+            raise CommandError("this run takes no keyboard driving (its exercise has no teleop)")
         run.teleop(str(command.get("key")), bool(command.get("pressed", True)))
     else:
         raise CommandError(
