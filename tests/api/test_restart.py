@@ -115,3 +115,26 @@ def test_a_crash_leaves_a_readable_recording_and_an_interrupted_run(tmp_path):
         assert wait_for_end(student, answer.json()["id"])["state"] == "finished"
     finally:
         stop_server(again)
+
+
+def test_login_url_gives_the_instructor_a_new_link_and_retires_the_old(tmp_path):
+    import subprocess
+    import sys
+
+    server = start_server(tmp_path)
+    old_token = server.admin_token
+    stop_server(server)
+    printed = subprocess.run(
+        [sys.executable, "-m", "server.cli", "login-url", "--data", str(tmp_path)],
+        capture_output=True, text=True, check=True, timeout=60,
+    ).stdout.strip()  # fmt: skip
+    assert printed.startswith("http://127.0.0.1:8000/login?token=")
+    new_token = printed.split("token=", 1)[1]
+    again = start_server(tmp_path)
+    try:
+        assert not any("log in as the instructor" in line for line in again.output)
+        assert again.client(old_token).get("/api/me").status_code == 401
+        me = again.client(new_token).get("/api/me").json()
+        assert me["role"] == "instructor"
+    finally:
+        stop_server(again)
