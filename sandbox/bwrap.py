@@ -117,7 +117,8 @@ def build_command(
     # A regular (not editable) install puts `server` into site-packages, which is bound above:
     # cover it with an empty directory so student code cannot import the server's code.
     server_dir = _installed_server_dir()
-    if server_dir and any(server_dir.startswith(root + os.sep) for root in roots):
+    visible = ["/usr", *roots]  # an install under /usr/local is bound along with /usr
+    if server_dir and any(server_dir.startswith(root + os.sep) for root in visible):
         command += ["--tmpfs", server_dir]
     command += ["--ro-bind", sandbox_package_dir(), f"{SANDBOX_ROOT}/sandbox"]
     env = node_environment(SCRATCH_DIR)
@@ -168,6 +169,9 @@ def probe() -> str | None:
             [bwrap, "--unshare-all", "--unshare-user", "--uid", str(NOBODY),
              "--ro-bind", "/usr", "/usr", "--symlink", "usr/lib64", "/lib64",
              "--symlink", "usr/lib", "/lib", "--symlink", "usr/bin", "/bin",
+             # A container that masks /proc refuses a fresh one: find that out now, not at
+             # every run.
+             "--proc", "/proc", "--dev", "/dev",
              "--die-with-parent", "/usr/bin/true"],
             capture_output=True, text=True, timeout=10,
         )  # fmt: skip

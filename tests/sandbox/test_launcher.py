@@ -122,3 +122,21 @@ def test_unsafe_mode_runs_and_says_danger_every_time(caplog):
         assert len(dangers) == 2
     finally:
         launcher.close()
+
+
+@pytest.mark.parametrize(
+    "server_dir",
+    [
+        "/usr/local/lib/python3.11/site-packages/server",  # pip install . into a system Python
+        "/usr/lib/python3/dist-packages/server",  # a Debian package
+    ],
+)
+def test_an_installed_server_under_usr_is_covered(monkeypatch, server_dir):
+    """/usr is bound into every sandbox; a server package installed below it must be hidden
+    under an empty tmpfs, or student code could read the server (reference solutions too)."""
+    from sandbox import bwrap
+
+    monkeypatch.setattr(bwrap, "_installed_server_dir", lambda: server_dir)
+    command = bwrap.build_command(3, 1024 * 1024, ["x"])
+    covered = [command[i + 1] for i, arg in enumerate(command) if arg == "--tmpfs"]
+    assert server_dir in covered
