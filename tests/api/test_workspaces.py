@@ -1,0 +1,41 @@
+"""Workspaces: an exercise's starter code until the first save, every save a version (identical
+saves are one), restoring an old version saves it again as the newest."""
+
+from __future__ import annotations
+
+
+def test_a_workspace_starts_from_the_starter_code_and_keeps_every_version(lab):
+    student = lab.student("saver")
+    exercise = student.get("/api/exercises/ir_scout_avoidance").json()
+    fresh = student.get("/api/workspaces/ir_scout_avoidance").json()["files"]
+    starter = {f"{s['name']}.py": s["code"] for s in exercise["starter"]}
+    assert len(starter) == 4  # the paper's four nodes, a file each
+    assert {f["filename"]: f["code"] for f in fresh} == starter
+    assert all(f["version"] == 0 for f in fresh)
+
+    url = "/api/workspaces/ir_scout_avoidance/files/planner.py"
+    assert student.put(url, json={"code": "v = 1\n"}).json()["version"] == 1
+    assert student.put(url, json={"code": "v = 1\n"}).json()["version"] == 1  # autosave, same
+    assert student.put(url, json={"code": "v = 2\n"}).json()["version"] == 2
+    versions = student.get(f"{url}/versions").json()["versions"]
+    assert [v["version"] for v in versions] == [2, 1] and "code" not in versions[0]
+    assert student.get(f"{url}/versions/1").json()["code"] == "v = 1\n"
+
+    restored = student.post(f"{url}/versions/1/restore").json()
+    assert (restored["version"], restored["code"]) == (3, "v = 1\n")
+    files = student.get("/api/workspaces/ir_scout_avoidance").json()["files"]
+    assert [(f["filename"], f["version"]) for f in files] == [("planner.py", 3)]
+    assert student.get(f"{url}/versions/9").status_code == 404
+
+
+def test_a_workspace_must_name_an_exercise_or_a_robot(lab):
+    student = lab.student("wanderer")
+    assert student.get("/api/workspaces/crop_rover").json()["files"] == []
+    answer = student.get("/api/workspaces/cooking")
+    assert answer.status_code == 404
+    assert "crowbot" in answer.json()["valid"] and "crowbot_distance_pid" in answer.json()["valid"]
+    too_many = [
+        student.put(f"/api/workspaces/crowbot/files/f{i}.py", json={"code": ""}).status_code
+        for i in range(17)
+    ]
+    assert too_many[:16] == [200] * 16 and too_many[16] == 422
