@@ -228,12 +228,13 @@ class Run(RunControls):
         for slot in self.slots.values():
             self._end_node(slot, reason)
         if self.recorder is not None:
-            if self.recorder.error and end_state is RunState.FINISHED:
-                end_state, reason = RunState.FAILED, f"failed: {self.recorder.error}"
             metrics = self.metrics()
             self.recorder.write_json("metrics", metrics)
             self.recorder.write_json("graph", self.bus.graph())
             paths = self.recorder.close()
+            # Checked after close: the last batch (or the summary) may be what failed.
+            if self.recorder.error and end_state is RunState.FINISHED:
+                end_state, reason = RunState.FAILED, f"failed: {self.recorder.error}"
         else:
             metrics, paths = self.metrics(), {}
         self.reason = reason
