@@ -114,16 +114,22 @@ def create_app(settings: Settings | None = None, launcher: Launcher | None = Non
                    admin_exercises):  # fmt: skip
         app.include_router(module.router)
 
-    @app.get("/", include_in_schema=False)
-    def index():
-        page = WEB_DIR / "index.html"
-        if page.is_file():
-            return FileResponse(page)
+    def page(name: str):
+        path = WEB_DIR / name
+        if path.is_file():
+            return FileResponse(path, headers={"Cache-Control": "no-cache"})
         return HTMLResponse(
             "<!doctype html><title>RoboDojo</title><h1>RoboDojo</h1>"
             "<p>The lab's API is running: see <a href='/docs'>/docs</a>.</p>"
         )
 
-    if (WEB_DIR / "static").is_dir():
-        app.mount("/static", StaticFiles(directory=WEB_DIR / "static"), name="static")
+    @app.get("/", include_in_schema=False)
+    def student_page():
+        return page("index.html")
+
+    @app.get("/admin", include_in_schema=False)
+    def instructor_page():
+        return page("admin.html")
+
+    app.mount("/static", StaticFiles(directory=WEB_DIR / "static", check_dir=False), name="static")
     return app

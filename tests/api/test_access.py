@@ -39,13 +39,14 @@ RUN_ROUTES = {
     ("GET", "/api/runs/{run_id}/logs"): "/api/runs/{id}/logs",
     ("GET", "/api/runs/{run_id}/logs/{node}.log"): "/api/runs/{id}/logs/saver.log",
     ("GET", "/api/runs/{run_id}/metrics.json"): "/api/runs/{id}/metrics.json",
+    ("GET", "/api/runs/{run_id}/graph"): "/api/runs/{id}/graph",
     ("GET", "/api/runs/{run_id}/artifacts"): "/api/runs/{id}/artifacts",
     ("GET", "/api/runs/{run_id}/artifacts/{name:path}"): "/api/runs/{id}/artifacts/saver/notes.txt",
 }
 # Routes on the caller's own things with no id of someone else's in them: another student
 # reaches only their own (empty) data; shown by test_workspaces_are_private.
 OWN_ROUTES = {"/api/workspaces/", "/api/me", "/api/logout", "/api/session"}
-PUBLIC_ROUTES = {"/login", "/", "/api/health"}
+PUBLIC_ROUTES = {"/login", "/", "/admin", "/api/health"}
 
 
 def app_routes() -> list[tuple[str, str]]:

@@ -277,6 +277,15 @@ def metrics_file(run_id: str, request: Request, caller: Caller = Depends(current
     return json.loads(path.read_text("utf-8"))
 
 
+@router.get("/{run_id}/graph", summary="Nodes and topics with measured rates (rqt_graph)")
+def graph(run_id: str, request: Request, caller: Caller = Depends(current_user)) -> dict:
+    record = visible_run(request, caller, run_id)
+    active = service_of(request).active(record.id)
+    if active is not None:
+        return active.run.bus.graph()
+    return json.loads(_run_file(record, "graph.json").read_text("utf-8"))
+
+
 @router.get("/{run_id}/artifacts", summary="Files the nodes saved")
 def artifact_list(run_id: str, request: Request, caller: Caller = Depends(current_user)) -> dict:
     record = visible_run(request, caller, run_id)
