@@ -26,6 +26,7 @@ from server.api.routes import (
     live,
     runs,
     session,
+    viz,
     workspaces,
 )
 from server.api.settings import Settings
@@ -111,7 +112,7 @@ def create_app(settings: Settings | None = None, launcher: Launcher | None = Non
         return await call_next(request)
 
     for module in (session, catalog, workspaces, runs, live, admin, admin_runs, admin_courses,
-                   admin_exercises):  # fmt: skip
+                   admin_exercises, viz):  # fmt: skip
         app.include_router(module.router)
 
     def page(name: str):

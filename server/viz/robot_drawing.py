@@ -1,0 +1,139 @@
+"""The robot in the scene: body, wheels, a nose that shows its heading, its four LEDs in the colour
+last sent on `Leds`, a buzzer indicator while `Buzzer` sounds, and a small block at every sensor
+frame (the IR ranger turns with its servo because its frame does).
+
+Sizes come from the robot's `RobotGeometry` (server/sim/robots/base.py). Everything hangs below one
+frame node, /robot, so a new pose is one position and one orientation message; colours and
+visibility are sent only when they change (viser keeps the latest of each anyway).
+"""
+
+from __future__ import annotations
+
+from server.sim.robots.base import RobotModel
+from server.viz.meshes import transformed, unit_box, unit_cylinder, yaw_wxyz
+
+ROBOT_NODE = "/robot"
+BODY_RGB = (60, 110, 200)
+NOSE_RGB = (250, 250, 250)
+WHEEL_RGB = (30, 30, 30)
+LED_OFF_RGB = (45, 45, 45)  # an unlit LED is dark plastic, not black paint
+BUZZER_RGB = (255, 200, 0)
+SENSOR_RGB = (220, 60, 60)
+WHEEL_WIDTH_FRACTION = 0.6  # [1] of the wheel radius: a plausible tyre width
+LED_RADIUS_FRACTION = 0.07  # [1] of the body radius
+LED_PLACEMENT = ((1, 1), (1, -1), (-1, 1), (-1, -1))  # corners of the top: front/back, left/right
+SENSOR_BLOCK_M = 0.02  # [m] side of the block drawn at a sensor frame
+
+
+def is_round(robot: RobotModel) -> bool:
+    """A disc-shaped robot (its footprint circle is its body) is drawn as a cylinder."""
+    g = robot.geometry
+    return abs(g.length_m - g.width_m) < 1e-6 and abs(g.length_m / 2 - g.body_radius_m) < 0.01
+
+
+class RobotDrawing:
+    """Adds the robot below /robot in `scene`; `update()` moves and recolours it."""
+
+    def __init__(self, scene, robot: RobotModel) -> None:
+        self.scene = scene
+        self.robot = robot
+        g = robot.geometry
+        self.clearance_m = 0.5 * g.wheel_radius_m  # [m] the body's underside above the floor
+        body_height_m = max(g.height_m - self.clearance_m, 0.01)
+        self.root = scene.add_frame(ROBOT_NODE, show_axes=False)
+        if is_round(robot):
+            vertices, faces = unit_cylinder()
+            radius = g.body_radius_m
+            scale = (radius, radius, body_height_m)
+        else:
+            vertices, faces = unit_box()
+            scale = (g.length_m, g.width_m, body_height_m)
+        offset = (0.0, 0.0, self.clearance_m + body_height_m / 2)
+        scene.add_mesh_simple(
+            f"{ROBOT_NODE}/body", transformed(vertices, scale, offset), faces, color=BODY_RGB
+        )
+        half_length = g.length_m / 2
+        scene.add_box(
+            f"{ROBOT_NODE}/nose",
+            color=NOSE_RGB,
+            dimensions=(0.25 * half_length, 0.3 * g.width_m, 0.004),
+            position=(0.75 * half_length, 0.0, g.height_m + 0.002),
+        )
+        wheel_vertices, wheel_faces = unit_cylinder()
+        wheel_width_m = WHEEL_WIDTH_FRACTION * g.wheel_radius_m
+        for side, sign in (("left", 1.0), ("right", -1.0)):
+            scene.add_mesh_simple(
+                f"{ROBOT_NODE}/wheel_{side}",
+                transformed(
+                    wheel_vertices,
+                    (g.wheel_radius_m, g.wheel_radius_m, wheel_width_m),
+                    (0.0, sign * g.track_m / 2, g.wheel_radius_m),
+                    swap_yz=True,
+                ),
+                wheel_faces,
+                color=WHEEL_RGB,
+            )
+        self.leds = []
+        if "Leds" in robot.commands:
+            reach = 0.5 * g.body_radius_m  # [m] LEDs at the corners of the top, inside the rim
+            for index, (forward, left) in enumerate(LED_PLACEMENT):
+                self.leds.append(
+                    scene.add_icosphere(
+                        f"{ROBOT_NODE}/led_{index}",
+                        radius=LED_RADIUS_FRACTION * g.body_radius_m,
+                        color=LED_OFF_RGB,
+                        position=(forward * reach, left * reach, g.height_m),
+                    )
+                )
+        self.buzzer = None
+        if "Buzzer" in robot.commands:
+            self.buzzer = scene.add_icosphere(
+                f"{ROBOT_NODE}/buzzer",
+                radius=0.3 * g.body_radius_m,
+                color=BUZZER_RGB,
+                opacity=0.6,
+                position=(0.0, 0.0, g.height_m + 0.4 * g.body_radius_m),
+                visible=False,
+            )
+        self.sensor_blocks: dict[str, object] = {}
+        self._shown: dict[str, object] = {}
+
+    def _changed(self, key: str, value: object) -> bool:
+        if self._shown.get(key) == value:
+            return False
+        self._shown[key] = value
+        return True
+
+    def update(
+        self,
+        pose: tuple[float, float, float] | None,
+        leds_rgb: tuple[int, int, int] | None,
+        buzzer_on: bool,
+        sensor_frames: dict[str, tuple[float, float, float, float]],
+    ) -> None:
+        """Pose (x [m], y [m], yaw [rad]); LED colour (None: never set); buzzer; sensor frames
+        as (x, y, heading [rad], sign) in the robot frame (see `view_state.SensorFrame`)."""
+        if pose is not None and self._changed("pose", pose):
+            x, y, yaw = pose
+            self.root.position = (x, y, 0.0)
+            self.root.wxyz = yaw_wxyz(yaw)
+        colour = LED_OFF_RGB if leds_rgb is None or not any(leds_rgb) else tuple(leds_rgb)
+        if self.leds and self._changed("leds", colour):
+            for led in self.leds:
+                led.color = colour
+        if self.buzzer is not None and self._changed("buzzer", buzzer_on):
+            self.buzzer.visible = buzzer_on
+        height = self.robot.geometry.height_m
+        for frame, (x, y, heading, _sign) in sensor_frames.items():
+            block = self.sensor_blocks.get(frame)
+            if block is None:
+                block = self.scene.add_box(
+                    f"{ROBOT_NODE}/sensors/{frame}",
+                    color=SENSOR_RGB,
+                    dimensions=(SENSOR_BLOCK_M, SENSOR_BLOCK_M, SENSOR_BLOCK_M / 2),
+                )
+                self.sensor_blocks[frame] = block
+            placed = (x, y, heading)
+            if self._changed(f"frame:{frame}", placed):
+                block.position = (x, y, height + SENSOR_BLOCK_M / 4)
+                block.wxyz = yaw_wxyz(heading)

@@ -1,0 +1,123 @@
+"""One run's 3D view on one ViserServer: the world, the robot, the overlays and the lights put
+together, `draw(state)` to show a `ViewState`, and the run's controls wired to the scene (a click
+on the floor of a mapped world sets the goal pose; dragging a movable light moves it).
+
+Who may use the controls is settled before anyone reaches this server: the proxy admits only the
+run's owner and instructors, the same people the run's control routes accept.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from typing import Protocol
+
+from server.sim.registry import get_robot
+from server.sim.world import load_world
+from server.viz.lights import LightMarkers
+from server.viz.overlays import Overlays
+from server.viz.rays import sensor_drawings
+from server.viz.robot_drawing import RobotDrawing
+from server.viz.view_state import ViewState
+from server.viz.world_scene import draw_world
+
+log = logging.getLogger("robodojo.viz")
+SENSOR_HEIGHT_FRACTION = 0.6  # [1] of the robot's height: where rays and scan points are drawn
+CAMERA_BACK = 0.55  # [1] of the world's larger side: the first camera stands this far south
+CAMERA_UP = 0.85  # [1] of the world's larger side, this high, looking at the centre
+
+
+class Controls(Protocol):
+    """What a live run accepts from the view (server.runs.controls.RunControls)."""
+
+    def set_goal(self, x: float, y: float, yaw: float = 0.0) -> None: ...
+
+    def move_light(self, name: str, x: float, y: float) -> None: ...
+
+
+def floor_point(origin, direction) -> tuple[float, float] | None:
+    """Where a click's ray meets the floor (z = 0), or None if it points upward."""
+    if direction[2] >= -1e-9:
+        return None
+    t = -origin[2] / direction[2]
+    return origin[0] + t * direction[0], origin[1] + t * direction[1]
+
+
+class SceneView:
+    def __init__(
+        self, server, robot_id: str, world_id: str, controls: Controls | None = None
+    ) -> None:
+        self.server = server
+        self.robot = get_robot(robot_id)
+        self.world = load_world(world_id)
+        self.sensors = self.robot.build_sensors()
+        self.controls = controls
+        scene = server.scene
+        scene.set_up_direction("+z")
+        min_x, min_y, max_x, max_y = self.world.bounds
+        span = max(max_x - min_x, max_y - min_y)
+        centre = ((min_x + max_x) / 2, (min_y + max_y) / 2)
+        server.initial_camera.position = (centre[0], min_y - CAMERA_BACK * span, CAMERA_UP * span)
+        server.initial_camera.look_at = (centre[0], centre[1], 0.0)
+        self.world_nodes = draw_world(scene, self.world)
+        self.robot_drawing = RobotDrawing(scene, self.robot)
+        spawn = self.world.spawns[0]
+        self.robot_drawing.update((spawn.x, spawn.y, spawn.yaw), None, False, {})
+        self.overlays = Overlays(scene, SENSOR_HEIGHT_FRACTION * self.robot.geometry.height_m)
+        self.lights = LightMarkers(
+            scene,
+            self.world.lights,
+            self.world.bounds,
+            on_move=self._move_light if controls is not None else None,
+        )
+        self.pose: tuple[float, float, float] | None = None
+        if controls is not None and self.world.grid_map is not None:
+            scene.on_click()(self._clicked)
+        self.status = server.gui.add_markdown("")
+
+    # ----------------------------------------------------------------------------- drawing
+    def draw(self, state: ViewState) -> None:
+        """Show `state` (call from one thread at a time)."""
+        drawings = sensor_drawings(state, self.robot, self.sensors, self.world)
+        with self.server.atomic():
+            self.robot_drawing.update(
+                state.pose, state.leds_rgb, state.buzzer_on, state.sensor_frames
+            )
+            self.overlays.draw_sensors(drawings)
+            self.overlays.draw_trail(state.trail)
+            self.overlays.draw_path(state.plan, state.pose, state.lookahead)
+            self.overlays.draw_goal(state.goal)
+            if state.lights:
+                self.lights.update(state.lights)
+        self.pose = state.pose
+
+    def set_status(self, text: str) -> None:
+        self.status.content = text
+
+    # ----------------------------------------------------------------------------- controls
+    def stop_controls(self) -> None:
+        """The run ended: clicks and drags do nothing from now on."""
+        self.controls = None
+
+    def _clicked(self, event) -> None:
+        controls = self.controls
+        point = floor_point(event.ray_origin, event.ray_direction)
+        if controls is None or point is None or not self.world.in_bounds(*point):
+            return
+        x, y = point
+        yaw = 0.0
+        if self.pose is not None:  # face the way the robot has to go to get there
+            yaw = math.atan2(y - self.pose[1], x - self.pose[0])
+        try:
+            controls.set_goal(x, y, yaw)
+        except Exception:  # a run that just ended: nothing to steer
+            log.info("goal (%.2f, %.2f) not set: the run is not running", x, y)
+
+    def _move_light(self, name: str, x: float, y: float) -> None:
+        controls = self.controls
+        if controls is None:
+            return
+        try:
+            controls.move_light(name, x, y)
+        except Exception:
+            log.info("light %s not moved: the run is not running", name)
