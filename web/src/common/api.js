@@ -1,0 +1,67 @@
+// The JSON API of `robodojo serve`: same-origin fetch with the session cookie. Every 4xx answer
+// carries {"detail": sentence}; ApiError keeps that sentence so it can be shown verbatim.
+
+export class ApiError extends Error {
+  constructor(status, detail) {
+    super(detail);
+    this.status = status;
+  }
+}
+
+async function detailOf(response) {
+  try {
+    const body = await response.json();
+    if (typeof body.detail === "string") return body.detail;
+    if (body.detail !== undefined) return JSON.stringify(body.detail);
+  } catch {
+    // not JSON: fall through to the status line
+  }
+  return `${response.status} ${response.statusText || "error"}`.trim();
+}
+
+/** fetch `path`; resolve with the decoded JSON, reject with an ApiError carrying the detail. */
+export async function api(path, { method = "GET", body, signal } = {}) {
+  const options = { method, credentials: "same-origin", signal, headers: {} };
+  if (body !== undefined) {
+    options.headers["content-type"] = "application/json";
+    options.body = JSON.stringify(body);
+  }
+  let response;
+  try {
+    response = await fetch(path, options);
+  } catch (error) {
+    if (error.name === "AbortError") throw error;
+    throw new ApiError(0, "the server does not answer; check that it is running and reload");
+  }
+  if (!response.ok) throw new ApiError(response.status, await detailOf(response));
+  const type = response.headers.get("content-type") || "";
+  return type.includes("json") ? response.json() : response.text();
+}
+
+/** Text of a file the API serves (a CSV, a log). */
+export async function apiText(path, { signal } = {}) {
+  const response = await fetch(path, { credentials: "same-origin", signal });
+  if (!response.ok) throw new ApiError(response.status, await detailOf(response));
+  return response.text();
+}
+
+/** Whether `url` answers 2xx, without downloading its body (HEAD, else GET aborted at the
+ * headers: a route may not answer HEAD). */
+export async function exists(url) {
+  try {
+    const head = await fetch(url, { method: "HEAD", credentials: "same-origin" });
+    if (head.ok) return true;
+    if (head.status !== 405) return false;
+  } catch {
+    return false;
+  }
+  const controller = new AbortController();
+  try {
+    const response = await fetch(url, { credentials: "same-origin", signal: controller.signal });
+    return response.ok;
+  } catch {
+    return false;
+  } finally {
+    controller.abort();
+  }
+}

@@ -1,0 +1,369 @@
+// The code editor: CodeMirror 6 with Python, a tab per node file of the workspace, each with its
+// own undo history; edits are saved to the workspace a moment after typing stops (each save is
+// a version on the server). Ctrl/Cmd+S saves now, Ctrl/Cmd+Enter runs.
+
+import { closeBrackets, closeBracketsKeymap } from "@codemirror/autocomplete";
+import { defaultKeymap, history, historyKeymap, indentWithTab } from "@codemirror/commands";
+import { python } from "@codemirror/lang-python";
+import {
+  bracketMatching,
+  defaultHighlightStyle,
+  indentOnInput,
+  indentUnit,
+  syntaxHighlighting,
+} from "@codemirror/language";
+import { highlightSelectionMatches, search, searchKeymap } from "@codemirror/search";
+import { EditorState, Prec } from "@codemirror/state";
+import {
+  drawSelection,
+  dropCursor,
+  EditorView,
+  highlightActiveLine,
+  highlightActiveLineGutter,
+  highlightSpecialChars,
+  keymap,
+  lineNumbers,
+} from "@codemirror/view";
+import { api } from "../common/api.js";
+import { byId, debounce, fill, h, when } from "../common/dom.js";
+import { app, fileOf, nodeOf, on } from "./state.js";
+
+const AUTOSAVE_MS = 1200; // [ms] after the last keystroke; each save is a version on the server
+const MAX_NODES = 8; // the API's limit of nodes in one run
+const NODE_NAME = /^[A-Za-z][A-Za-z0-9_]{0,39}$/;
+
+const tabsElement = byId("file-tabs");
+const statusElement = byId("save-status");
+let view = null;
+let workspace = null; // the workspace the files below belong to
+/** filename -> {filename, state, savedCode, version, savedAt, saving, error, autosave} */
+const files = new Map();
+let current = null;
+let onRun = () => {};
+
+/** The extensions of one file's editor state; `filename` lets edits mark the right file. */
+export function pythonExtensions({ readOnly = false, label = "Python code" } = {}) {
+  return [
+    lineNumbers(),
+    highlightActiveLineGutter(),
+    highlightSpecialChars(),
+    drawSelection(),
+    indentUnit.of("    "),
+    syntaxHighlighting(defaultHighlightStyle, { fallback: true }),
+    bracketMatching(),
+    highlightSelectionMatches(),
+    python(),
+    EditorState.readOnly.of(readOnly),
+    EditorView.contentAttributes.of({ "aria-label": label }),
+  ];
+}
+
+function fileExtensions(filename) {
+  return [
+    pythonExtensions({ label: `Code of ${filename} (Escape then Tab leaves the editor)` }),
+    history(),
+    dropCursor(),
+    EditorState.allowMultipleSelections.of(true),
+    indentOnInput(),
+    closeBrackets(),
+    highlightActiveLine(),
+    search({ top: true }),
+    Prec.high(
+      keymap.of([
+        { key: "Mod-s", preventDefault: true, run: () => (saveNow(filename), true) },
+        { key: "Mod-Enter", preventDefault: true, run: () => (onRun(), true) },
+      ]),
+    ),
+    keymap.of([...closeBracketsKeymap, ...defaultKeymap, ...searchKeymap, ...historyKeymap, indentWithTab]),
+    EditorView.updateListener.of((update) => {
+      if (update.docChanged) edited(filename);
+    }),
+  ];
+}
+
+export function initEditor({ run }) {
+  onRun = run;
+  view = new EditorView({
+    parent: byId("editor"),
+    state: EditorState.create({ doc: "# loading…", extensions: pythonExtensions({ readOnly: true }) }),
+  });
+  on("target", ({ changedWorkspace }) => changedWorkspace && load(app.target.workspace));
+  on("goto-line", ({ node, line }) => gotoLine(node, line));
+  tabsElement.addEventListener("keydown", tabKeys);
+  initAddNode();
+  window.addEventListener("beforeunload", () => {
+    for (const file of files.values()) if (isDirty(file)) save(file, { keepalive: true });
+  });
+}
+
+/** The code of every node, in tab order: what a run is started with. */
+export function nodes() {
+  return [...files.values()].map((file) => ({ name: nodeOf(file.filename), code: code(file) }));
+}
+
+/** Edited since the last save (starter code nobody touched is not saved). */
+function isDirty(file) {
+  return Boolean(file.edited) && code(file) !== file.savedCode;
+}
+
+function code(file) {
+  return file.filename === current ? view.state.doc.toString() : file.state.doc.toString();
+}
+
+async function load(name) {
+  await flushAll();
+  workspace = name;
+  files.clear();
+  current = null;
+  fill(tabsElement);
+  setStatus("Loading…");
+  let listing;
+  try {
+    listing = await api(`/api/workspaces/${encodeURIComponent(name)}`);
+  } catch (error) {
+    setStatus(`Could not load the code: ${error.message}`, true);
+    return;
+  }
+  if (workspace !== name) return; // another workspace was chosen meanwhile
+  const loaded = listing.files.length ? listing.files : [{ filename: "controller.py", version: 0, code: template() }];
+  for (const entry of loaded) addFile(entry.filename, entry.code, entry.version, entry.saved_at);
+  show(loaded[0].filename);
+}
+
+function addFile(filename, text, version, savedAt) {
+  const file = {
+    filename,
+    state: EditorState.create({ doc: text, extensions: fileExtensions(filename) }),
+    savedCode: version > 0 ? text : null, // starter code is not saved until it is edited
+    version,
+    savedAt,
+    saving: null,
+    error: null,
+  };
+  file.autosave = debounce(() => save(file), AUTOSAVE_MS);
+  files.set(filename, file);
+  renderTabs();
+  return file;
+}
+
+/** A step-API skeleton for a new node of the target robot. */
+function template() {
+  const robot = app.robots.get(app.target?.robot);
+  const sensor = robot?.topics.find((t) => t.direction === "publish" && /^[A-Za-z_]\w*$/.test(t.name));
+  const name = sensor ? sensor.name : "Distance";
+  return `"""My controller for the ${robot?.title || "robot"}. Step API: step(obs) runs RATE_HZ times a second."""
+
+RATE_HZ = 10  # [Hz]
+SUBSCRIBE = ["${name}"]  # obs.${name} is the latest message (None before the first one)
+
+
+def step(obs):
+    if obs.${name} is None:
+        return None  # nothing has arrived yet: publish nothing
+    print(obs.time, obs.${name})
+    return None  # or (v [m/s], w [rad/s]), or {topic: message}
+`;
+}
+
+function renderTabs() {
+  fill(
+    tabsElement,
+    [...files.values()].map((file) => {
+      const dirty = isDirty(file);
+      return h(
+        "button",
+        {
+          type: "button",
+          role: "tab",
+          class: "file-tab",
+          "aria-selected": String(file.filename === current),
+          "aria-controls": "editor",
+          tabindex: file.filename === current ? 0 : -1,
+          dataset: { testid: "editor-tab", file: file.filename },
+          onclick: () => show(file.filename),
+        },
+        file.filename,
+        dirty ? h("span", { class: "dirty", title: "unsaved changes", "aria-label": "(unsaved)" }, " •") : null,
+      );
+    }),
+  );
+}
+
+function tabKeys(event) {
+  const buttons = [...tabsElement.querySelectorAll('[role="tab"]')];
+  const index = buttons.indexOf(document.activeElement);
+  if (index < 0) return;
+  const step = { ArrowRight: 1, ArrowLeft: -1 }[event.key];
+  if (!step) return;
+  event.preventDefault();
+  const next = buttons[(index + step + buttons.length) % buttons.length];
+  show(next.dataset.file);
+  tabsElement.querySelector(`[data-file="${CSS.escape(next.dataset.file)}"]`)?.focus();
+}
+
+function show(filename) {
+  if (current && files.has(current)) files.get(current).state = view.state;
+  current = filename;
+  view.setState(files.get(filename).state);
+  renderTabs();
+  showStatus();
+}
+
+function edited(filename) {
+  const file = files.get(filename);
+  if (!file) return;
+  file.edited = true;
+  file.error = null;
+  file.autosave();
+  if (filename === current) {
+    renderTabsSoon();
+    showStatus();
+  }
+}
+
+const renderTabsSoon = debounce(renderTabs, 150);
+
+async function save(file, { keepalive = false } = {}) {
+  file.autosave.cancel();
+  const text = code(file);
+  if (text === file.savedCode) return;
+  if (file.saving) {
+    await file.saving; // one save at a time per file, the newest text last
+    return save(file);
+  }
+  const url = `/api/workspaces/${encodeURIComponent(workspace)}/files/${encodeURIComponent(file.filename)}`;
+  if (keepalive) {
+    fetch(url, { method: "PUT", keepalive: true, credentials: "same-origin", headers: { "content-type": "application/json" }, body: JSON.stringify({ code: text }) });
+    return;
+  }
+  const target = workspace;
+  file.saving = api(url, { method: "PUT", body: { code: text } })
+    .then((saved) => {
+      if (target !== workspace) return;
+      file.savedCode = text;
+      file.version = saved.version;
+      file.savedAt = saved.saved_at;
+      file.error = null;
+    })
+    .catch((error) => {
+      file.error = error.message;
+    })
+    .finally(() => {
+      file.saving = null;
+      if (target === workspace) {
+        renderTabs();
+        if (file.filename === current) showStatus();
+      }
+    });
+  if (file.filename === current) showStatus();
+  return file.saving;
+}
+
+function saveNow(filename) {
+  const file = files.get(filename);
+  if (file) save(file);
+}
+
+/** Save every file with unsaved edits; resolves when the server has them all. */
+export async function flushAll() {
+  await Promise.all([...files.values()].map((file) => (isDirty(file) ? save(file) : file.saving)));
+}
+
+function showStatus() {
+  const file = files.get(current);
+  if (!file) return setStatus("");
+  if (file.error) return setStatus(`Not saved: ${file.error}`, true);
+  if (file.saving) return setStatus("Saving…");
+  if (file.savedCode === null && !file.edited) return setStatus("Starter code");
+  if (code(file) !== file.savedCode) return setStatus("Unsaved changes");
+  setStatus(`Saved v${file.version}${file.savedAt ? ` at ${when(file.savedAt)}` : ""}`);
+}
+
+function setStatus(text, error = false) {
+  statusElement.textContent = text;
+  statusElement.classList.toggle("error", error);
+}
+
+/** The file on show and its workspace (for the versions dialog). */
+export function currentFile() {
+  const file = files.get(current);
+  return file ? { workspace, filename: file.filename, version: file.version, code: code(file) } : null;
+}
+
+/** Replace the text of the file on show (an undoable edit); `saved` marks it as that version. */
+export function replaceCurrent(text, saved = null) {
+  const file = files.get(current);
+  if (!file) return;
+  view.dispatch({ changes: { from: 0, to: view.state.doc.length, insert: text } });
+  if (saved) {
+    file.autosave.cancel();
+    file.savedCode = text;
+    file.version = saved.version;
+    file.savedAt = saved.saved_at;
+    file.error = null;
+  }
+  renderTabs();
+  showStatus();
+}
+
+/** Starter code of the file on show, if the exercise has one. */
+export function starterOf(filename) {
+  return app.target?.exercise?.starter?.find((s) => fileOf(s.name) === filename)?.code ?? null;
+}
+
+function gotoLine(node, lineNumber) {
+  const filename = fileOf(node);
+  if (!files.has(filename)) return;
+  show(filename);
+  const doc = view.state.doc;
+  const line = doc.line(Math.max(1, Math.min(lineNumber, doc.lines)));
+  view.dispatch({
+    selection: { anchor: line.from, head: line.to },
+    effects: EditorView.scrollIntoView(line.from, { y: "center" }),
+  });
+  view.focus();
+}
+
+function initAddNode() {
+  const button = byId("add-node");
+  const form = byId("add-node-form");
+  const input = byId("add-node-name");
+  button.addEventListener("click", () => {
+    form.hidden = !form.hidden;
+    button.setAttribute("aria-expanded", String(!form.hidden));
+    if (!form.hidden) input.focus();
+  });
+  form.addEventListener("keydown", (event) => {
+    if (event.key === "Escape") {
+      form.hidden = true;
+      button.setAttribute("aria-expanded", "false");
+      button.focus();
+    }
+  });
+  form.addEventListener("submit", (event) => {
+    event.preventDefault();
+    const name = input.value.trim();
+    let problem = null;
+    if (!NODE_NAME.test(name)) problem = "a node name starts with a letter, then letters, digits or _ (at most 40)";
+    else if (files.has(fileOf(name))) problem = `there is already a node '${name}'`;
+    else if (files.size >= MAX_NODES) problem = `a run has at most ${MAX_NODES} nodes`;
+    input.setCustomValidity(problem || "");
+    if (problem) {
+      input.reportValidity();
+      return;
+    }
+    const file = addFile(fileOf(name), template(), 0, null);
+    file.edited = true;
+    show(file.filename);
+    save(file);
+    input.value = "";
+    form.hidden = true;
+    button.setAttribute("aria-expanded", "false");
+    view.focus();
+  });
+  input.addEventListener("input", () => input.setCustomValidity(""));
+}
+
+export function focusEditor() {
+  view?.focus();
+}
