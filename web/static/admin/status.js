@@ -1,0 +1,103 @@
+// Server status: active runs, sandbox processes, CPU and memory, polled every 5 s while the page
+// is visible (a line in the header; cards on the Status section).
+
+import { get } from "./api.js";
+import { $, clearError, h, seconds, showError } from "./dom.js";
+
+const POLL_MS = 5000;
+let timer = null;
+let running = false;
+
+function card(title, value, ...lines) {
+  return h(
+    "div",
+    { className: "card" },
+    h("h2", {}, title),
+    h("p", { className: "big" }, value),
+    ...lines.filter(Boolean).map((line) => h("p", { className: "muted small" }, line)),
+  );
+}
+
+function render(s) {
+  const runs = s.runs || {};
+  const byState = Object.entries(runs.active_by_state || {})
+    .map(([state, n]) => `${n} ${state}`)
+    .join(", ");
+  const machine = s.machine || {};
+  const server = s.server || {};
+  const sandbox = s.sandbox || {};
+  const load = (machine.load_average || []).map((x) => x.toFixed(2)).join(" / ");
+  $("#status-cards").replaceChildren(
+    card(
+      "Active runs",
+      String(runs.active_runs ?? "–"),
+      byState || "none",
+      `limits: ${runs.max_runs_total ?? "?"} in all, ${runs.max_runs_per_student ?? "?"} per student`,
+      `${runs.live_viewers ?? 0} live viewer(s); ${s.stored_active_runs ?? 0} active in the database`,
+    ),
+    card(
+      "Sandbox processes",
+      String(sandbox.count ?? runs.sandbox_processes ?? "–"),
+      `${sandbox.rss_mib ?? "?"} MiB resident`,
+      `${runs.sandbox_processes ?? 0} running student code; ${runs.warm_pool ?? 0} kept warm`,
+    ),
+    card(
+      "CPU",
+      `${machine.cpus ?? "?"} core${machine.cpus === 1 ? "" : "s"}`,
+      `load average (1, 5, 15 min): ${load || "?"}`,
+      `server process: ${server.cpu_percent ?? "?"} % of a core, ${server.threads ?? "?"} threads`,
+    ),
+    card(
+      "Memory",
+      `${machine.memory_used_percent ?? "?"} % used`,
+      `${machine.memory_available_mib ?? "?"} MiB available`,
+      `server process: ${server.rss_mib ?? "?"} MiB resident`,
+    ),
+    card(
+      "Server",
+      `up ${seconds(s.uptime_s)}`,
+      `database: ${s.database ?? "?"}`,
+      s.queues ? `waiting runs: ${s.queues.waiting_runs}; ${s.queues.note || ""}` : null,
+    ),
+  );
+  $("#status-updated").textContent = `Updated ${new Date().toLocaleTimeString()}; every ${POLL_MS / 1000} s.`;
+  const loadNow = machine.load_average ? machine.load_average[0].toFixed(1) : "?";
+  $("#status-summary").textContent = `${runs.active_runs ?? 0} active run${runs.active_runs === 1 ? "" : "s"} · load ${loadNow}/${machine.cpus ?? "?"} · mem ${machine.memory_used_percent ?? "?"} %`;
+}
+
+async function poll() {
+  try {
+    const s = await get("/api/admin/status");
+    clearError($("#status-error"));
+    render(s);
+  } catch (error) {
+    showError($("#status-error"), error);
+  }
+}
+
+function schedule() {
+  clearTimeout(timer);
+  timer = null;
+  if (!running || document.hidden) return;
+  timer = setTimeout(async () => {
+    await poll();
+    schedule();
+  }, POLL_MS);
+}
+
+export function startStatus() {
+  running = true;
+  poll();
+  schedule();
+  document.addEventListener("visibilitychange", () => {
+    if (!document.hidden && running) poll();
+    schedule();
+  });
+}
+
+export function stopStatus() {
+  running = false;
+  schedule();
+}
+
+export const refreshStatus = poll;
