@@ -45,22 +45,17 @@ export async function apiText(path, { signal } = {}) {
   return response.text();
 }
 
-/** Whether `url` answers 2xx, without downloading its body (HEAD, else GET aborted at the
- * headers: a route may not answer HEAD). */
-export async function exists(url) {
-  try {
-    const head = await fetch(url, { method: "HEAD", credentials: "same-origin" });
-    if (head.ok) return true;
-    if (head.status !== 405) return false;
-  } catch {
-    return false;
-  }
+/** Whether `url` answers 2xx, without downloading its body: a GET aborted once the headers
+ * are in (not HEAD: FastAPI answers HEAD on a GET route with 405, which browsers log as an
+ * error). Resolves {ok, detail}: the server's sentence when it is not there. */
+export async function probe(url) {
   const controller = new AbortController();
   try {
     const response = await fetch(url, { credentials: "same-origin", signal: controller.signal });
-    return response.ok;
+    if (response.ok) return { ok: true, detail: "" };
+    return { ok: false, detail: await detailOf(response) };
   } catch {
-    return false;
+    return { ok: false, detail: "the server does not answer" };
   } finally {
     controller.abort();
   }

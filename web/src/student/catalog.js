@@ -29,6 +29,9 @@ export function initCatalog() {
     const wanted = parseHash(location.hash);
     if (wanted && workspaceKey(wanted) !== workspaceKey(app.target || {})) choose(wanted);
   });
+  const details = byId("exercise-text");
+  details.open = localStorage.getItem("robodojo.textOpen") !== "false";
+  details.addEventListener("toggle", () => localStorage.setItem("robodojo.textOpen", String(details.open)));
   byId("picker").hidden = false;
   const saved = parseHash(location.hash) || readSaved() || { exercise: exercises[0]?.id };
   choose(saved);

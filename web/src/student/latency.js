@@ -62,7 +62,8 @@ function table(run) {
     h(
       "table",
       { class: "data-table" },
-      h("thead", {}, h("tr", {}, ["node", "wakes", "p50", "p95", "p99", "max", "outcome"].map((c) => h("th", { scope: "col" }, c)))),
+      h("caption", { class: "sr-only" }, "Loop period of each node"),
+      h("thead", {}, h("tr", {}, ["node", "wakes", "p50", "p95", "p99", "max", "outcome"].map((c, i) => h("th", { scope: "col", class: i && i < 6 ? "num" : null }, c)))),
       h(
         "tbody",
         {},
@@ -129,7 +130,10 @@ function histogram(name, summary, what) {
         "g",
         { class: `mark ${label}` },
         svg("line", { x1: xOf(value), x2: xOf(value), y1: 8, y2: 8 + plotHeight }),
-        svg("text", { x: xOf(value) + 3, y: 18 + index * 12 }, `${label} ${seconds(value)}`),
+        // The label sits on the side of the line with more room.
+        xOf(value) > left + plotWidth / 2
+          ? svg("text", { x: xOf(value) - 3, y: 18 + index * 12, "text-anchor": "end" }, `${label} ${seconds(value)}`)
+          : svg("text", { x: xOf(value) + 3, y: 18 + index * 12 }, `${label} ${seconds(value)}`),
       ),
     );
   return h(

@@ -32,6 +32,7 @@ const plotted = new Map();
 let selected = null;
 let recorded = false; // the run on show has ended: its CSV files hold every sample
 let csvTopics = null; // topic names that have a CSV file (for an ended run)
+let xMax = 0; // [s] the newest time on any chart: all charts span 0..xMax, so they line up
 
 export function initPlots() {
   fill(
@@ -48,9 +49,13 @@ export function initPlots() {
   );
   new ResizeObserver(resizeCharts).observe(chartArea);
   on("target", ({ target }) => {
-    for (const topic of plotted.keys()) removeChart(topic);
+    for (const topic of [...plotted.keys()]) removeChart(topic);
     topics.clear();
     selected = null;
+    recorded = false;
+    csvTopics = null;
+    xMax = 0;
+    note.textContent = "";
     for (const t of robotTopics(target.robot)) topicEntry(t.name, t.type);
     for (const { topic, path } of savedSelection(target.robot)) addPath(topic, path, { save: false });
     renderTopics();
@@ -59,6 +64,7 @@ export function initPlots() {
   on("run-shown", ({ live }) => {
     recorded = !live;
     csvTopics = null;
+    xMax = 0;
     for (const entry of topics.values()) Object.assign(entry, { samples: [], fromCsv: false, loading: null });
     note.textContent = live ? "" : "Loading the run's recording…";
     for (const topic of plotted.keys()) redraw(topic);
@@ -92,7 +98,10 @@ function receive(frame) {
     if (frame.topic === selected) renderFields();
   }
   if (samples.length > entry.cap * 1.1) samples.splice(0, samples.length - entry.cap);
-  if (plotted.has(frame.topic)) scheduleRedraw(frame.topic);
+  if (plotted.has(frame.topic)) {
+    xMax = Math.max(xMax, frame.time_s);
+    scheduleRedraw(frame.topic);
+  }
 }
 
 /** The run has ended: every sample of the plotted (and the selected) topics, from its CSV. */
@@ -122,6 +131,7 @@ async function fromCsv(topic, runId) {
       if (app.run?.id !== runId) return;
       entry.samples = csvSamples(text);
       entry.fromCsv = true;
+      if (plotted.has(topic) && entry.samples.length) xMax = Math.max(xMax, entry.samples[entry.samples.length - 1].time_s);
     })
     .catch((error) => {
       note.textContent = `${topic}: ${error.message}`;
@@ -130,7 +140,7 @@ async function fromCsv(topic, runId) {
       entry.loading = null;
     });
   await entry.loading;
-  if (plotted.has(topic)) redraw(topic);
+  for (const name of plotted.keys()) redraw(name); // the common time span may have grown
   if (topic === selected) renderFields();
 }
 
@@ -286,7 +296,7 @@ function rebuildChart(topic) {
   chart.chart?.destroy();
   const options = {
     ...chartSize(),
-    scales: { x: { time: false } },
+    scales: { x: { time: false, range: (u, min, max) => [0, Math.max(max || 0, xMax) || 1] } },
     cursor: { sync: { key: "robodojo-plots" } },
     axes: [{ label: "time [s]", labelSize: 18, size: 36 }, { size: 56 }],
     series: [{ label: "t [s]", value: (u, v) => (v === null || v === undefined ? "-" : v.toFixed(2)) }].concat(

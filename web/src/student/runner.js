@@ -45,6 +45,7 @@ export function initRunner() {
     clockInput.value = target.exercise?.clock || "lockstep";
     durationInput.value = target.exercise?.duration_s ?? 30;
     seedInput.value = "";
+    forget();
   });
   controls();
 }
@@ -74,6 +75,22 @@ export async function start() {
   }
 }
 
+/** No run on show (another exercise was chosen); a live run goes on, unwatched. */
+function forget() {
+  app.live?.close();
+  app.live = null;
+  clearInterval(poller);
+  poller = null;
+  app.run = null;
+  state = null;
+  timeS = 0;
+  stateText.textContent = "";
+  say("");
+  showChecks(null);
+  progressOf(null);
+  controls();
+}
+
 /** Put a run on show: live (followed over its websocket) unless it has ended. */
 export function showRun(run) {
   app.live?.close();
@@ -84,6 +101,7 @@ export function showRun(run) {
   state = run.state;
   timeS = run.time_s || 0;
   endedRunId = null;
+  stateText.textContent = run.reason || run.state;
   say(failureText(run));
   showChecks(run);
   const live = !END_STATES.has(run.state);

@@ -2,7 +2,7 @@
 // /api/runs/{id}/viz/, in a frame. Loaded when its tab is first opened (WebGL is not free); a
 // server without the route answers 404 and the panel says so.
 
-import { exists } from "../common/api.js";
+import { probe } from "../common/api.js";
 import { byId, fill, h } from "../common/dom.js";
 import { app, on } from "./state.js";
 
@@ -29,10 +29,10 @@ export async function vizShown() {
   shownRun = run.id;
   const url = `/api/runs/${run.id}/viz/`;
   fill(panel, h("p", { class: "hint" }, "Looking for the 3D view…"));
-  const available = await exists(url);
+  const available = await probe(url);
   if (shownRun !== run.id) return;
-  if (!available) {
-    fill(panel, h("p", { class: "hint", dataset: { testid: "viz-unavailable" } }, "3D view not available for this run."));
+  if (!available.ok) {
+    fill(panel, h("p", { class: "hint", dataset: { testid: "viz-unavailable" } }, `3D view not available (${available.detail}).`));
     return;
   }
   fill(

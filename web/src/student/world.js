@@ -189,10 +189,16 @@ function enable(live) {
 
 /** A live command; the server's sentence when it refuses. */
 function send(op, fields) {
-  if (!app.live) return Promise.resolve();
+  if (!app.live) return Promise.resolve(false);
   return app.live.command(op, fields).then(
-    () => (status.textContent = ""),
-    (error) => (status.textContent = error.message),
+    () => {
+      status.textContent = "";
+      return true;
+    },
+    (error) => {
+      status.textContent = error.message;
+      return false;
+    },
   );
 }
 
@@ -206,11 +212,13 @@ function sendGoal(x, y, yaw) {
 }
 
 function sendLight(x, y) {
-  light = { x, y };
   map.inputs.lightX.value = x.toFixed(2);
   map.inputs.lightY.value = y.toFixed(2);
-  draw();
-  send("light", { x, y });
+  send("light", { x, y }).then((ok) => {
+    if (!ok) return;
+    light = { x, y }; // drawn once the server has moved it
+    draw();
+  });
 }
 
 /** World coordinates of a pointer event on the map. */
@@ -271,7 +279,7 @@ function draw() {
   const lines = [];
   for (let x = Math.ceil(x0 / step) * step; x <= x1 + 1e-9; x += step) lines.push(svg("line", { x1: x, x2: x, y1: y0, y2: y1 }));
   for (let y = Math.ceil(y0 / step) * step; y <= y1 + 1e-9; y += step) lines.push(svg("line", { x1: x0, x2: x1, y1: y, y2: y }));
-  const size = span / 40; // robot and markers scale with the world
+  const size = span / 60; // robot and markers scale with the world
   fill(
     map.layer,
     svg("rect", { x: x0, y: y0, width: x1 - x0, height: y1 - y0, class: "floor" }),
@@ -280,16 +288,20 @@ function draw() {
     trail.length > 1 ? svg("polyline", { class: "trail", points: trail.map((p) => p.join(",")).join(" "), "stroke-width": span / 250 }) : null,
     goal ? marker(goal, size, "goal") : null,
     light ? svg("circle", { cx: light.x, cy: light.y, r: size * 0.8, class: "light" }) : null,
-    pose ? marker(pose, size * 1.3, "robot") : null,
+    pose ? marker(pose, size * 1.2, "robot") : null,
   );
 }
 
+/** An arrowhead at p pointing along p.yaw: the robot filled, a goal outlined. */
 function marker(p, size, kind) {
-  const tip = [p.x + Math.cos(p.yaw) * size * 1.4, p.y + Math.sin(p.yaw) * size * 1.4];
+  const at = (ahead, left) => [
+    p.x + Math.cos(p.yaw) * ahead - Math.sin(p.yaw) * left,
+    p.y + Math.sin(p.yaw) * ahead + Math.cos(p.yaw) * left,
+  ];
+  const points = [at(size * 1.3, 0), at(-size * 0.8, size * 0.8), at(-size * 0.4, 0), at(-size * 0.8, -size * 0.8)];
   return svg(
     "g",
     { class: kind, dataset: { testid: `map-${kind}` } },
-    svg("circle", { cx: p.x, cy: p.y, r: size }),
-    svg("line", { x1: p.x, y1: p.y, x2: tip[0], y2: tip[1], "stroke-width": size / 3 }),
+    svg("polygon", { points: points.map((q) => q.join(",")).join(" "), "stroke-width": size / 5 }),
   );
 }
