@@ -3,9 +3,10 @@ by field, before anything else sees it (a 422 names the field)."""
 
 from __future__ import annotations
 
+import re
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, field_validator
 
 NAME_PATTERN = r"^[A-Za-z][A-Za-z0-9_]{0,39}$"  # a node name, as in a launch file
 ID_PATTERN = r"^[A-Za-z0-9_\-]{1,64}$"
@@ -47,8 +48,15 @@ class SessionCreate(Strict):
 class UserCreate(Strict):
     name: str = Field(min_length=1, max_length=120)
     role: Literal["student", "instructor"] = "student"
-    email: str | None = Field(None, max_length=254, pattern=EMAIL_PATTERN)
+    email: str | None = Field(None, max_length=254)
     course: str | None = Field(None, pattern=ID_PATTERN, description="enrol in this course id")
+
+    @field_validator("email")
+    @classmethod
+    def _plausible_email(cls, value: str | None) -> str | None:
+        if value is not None and not re.match(EMAIL_PATTERN, value):
+            raise ValueError(f"'{value}' does not look like an email address (name@domain)")
+        return value
 
 
 class UserUpdate(Strict):

@@ -98,3 +98,42 @@ def test_admin_run_filters_and_status(lab):
     assert status["server"]["rss_mib"] > 10
     assert status["database"] in ("sqlite", "postgresql")
     assert status["machine"]["cpus"] >= 1
+
+
+def test_pages_learn_who_is_logged_in_without_a_401(lab):
+    assert lab.client().get("/api/session").json() == {"user": None}
+    student = lab.student("pager")
+    assert student.get("/api/session").json()["user"]["role"] == "student"
+
+
+def test_the_login_link_lands_instructors_on_their_console(lab):
+    landing = lab.client().get(f"/login?token={lab.admin_token}", follow_redirects=False)
+    assert landing.headers["location"] == "/admin"
+    _, token = lab.new_user("lander")
+    assert (
+        lab.client().get(f"/login?token={token}", follow_redirects=False).headers["location"] == "/"
+    )
+
+
+def test_active_runs_with_their_students_names(lab):
+    admin = lab.admin()
+    student = lab.student("Named Student")
+    run_id = student.post(
+        "/api/runs",
+        json={"robot": "crowbot", "world": "wall_approach", "clock": "realtime", "duration": 30,
+              "nodes": [{"name": "d", "code": STEP_CONTROLLER}]},
+    ).json()["id"]  # fmt: skip
+    active = admin.get("/api/admin/runs", params={"state": "active"}).json()["runs"]
+    mine = [r for r in active if r["id"] == run_id]
+    assert mine and mine[0]["user_name"] == "Named Student"
+    student.post(f"/api/runs/{run_id}/stop")
+    wait_for_end(student, run_id)
+    active = admin.get("/api/admin/runs", params={"state": "active"}).json()["runs"]
+    assert run_id not in [r["id"] for r in active]
+
+
+def test_a_bad_email_is_a_sentence_not_a_pattern(lab):
+    answer = lab.admin().post("/api/admin/users", json={"name": "x", "email": "nope"})
+    assert answer.status_code == 422
+    assert "does not look like an email address" in answer.json()["detail"]
+    assert "^" not in answer.json()["detail"]

@@ -5,14 +5,17 @@ from __future__ import annotations
 import os
 import time
 from datetime import datetime
+from typing import Literal
 
 import psutil
 from fastapi import APIRouter, Depends, HTTPException, Query, Request
+from sqlalchemy import select
 
 from server.api.auth import Caller, instructor
 from server.api.routes.runs import run_out
 from server.runs.state import RunState
 from server.store import runs as run_store
+from server.store.models import User
 
 router = APIRouter(prefix="/api/admin", tags=["admin"])
 STARTED = time.time()
@@ -30,7 +33,9 @@ def all_runs(
     _: Caller = Depends(instructor),
     user: str | None = Query(None, max_length=64),
     exercise: str | None = Query(None, max_length=64),
-    state: RunState | None = None,
+    state: RunState | Literal["active"] | None = Query(
+        None, description="a run state, or 'active' for every state before the end"
+    ),
     since: datetime | None = Query(None, description="created at or after (ISO 8601)"),
     until: datetime | None = Query(None, description="created before (ISO 8601)"),
     limit: int = Query(100, ge=1, le=500),
@@ -47,8 +52,17 @@ def all_runs(
     )
     with request.app.state.store.session() as db:
         rows, total = run_store.listing(db, where)
+        names = {
+            user.id: user.name
+            for user in db.scalars(select(User).where(User.id.in_({r.user_id for r in rows})))
+        }
     service = request.app.state.runs
-    return {"total": total, "runs": [run_out(r, service) for r in rows]}
+    runs = []
+    for record in rows:
+        out = run_out(record, service)
+        out["user_name"] = names.get(record.user_id)
+        runs.append(out)
+    return {"total": total, "runs": runs}
 
 
 @router.post("/runs/{run_id}/stop", summary="Stop anyone's run")

@@ -50,7 +50,11 @@ def login_link(request: Request, token: str = "") -> Response:
             status_code=401,
         )
     # 303 to the page, so a reload does not resend the token; the token leaves the address bar.
-    response = RedirectResponse("/", status_code=303)
+    # Instructors land on their console, students on the lab.
+    with request.app.state.store.session() as db:
+        user = accounts.user_by_session(db, session_token)
+        landing = "/admin" if user is not None and user.role == "instructor" else "/"
+    response = RedirectResponse(landing, status_code=303)
     _set_cookie(response, request, session_token)
     response.headers["Referrer-Policy"] = "no-referrer"
     return response
@@ -75,6 +79,21 @@ def logout(request: Request, response: Response) -> dict:
             accounts.end_session(db, token)
     response.delete_cookie(SESSION_COOKIE, path="/")
     return {"ok": True}
+
+
+@router.get("/api/session", summary="Who is logged in, if anyone (never 401: for pages)")
+def session_state(request: Request) -> dict:
+    from server.api.auth import SESSION_COOKIE as COOKIE
+    from server.api.auth import _bearer, resolve
+
+    caller = resolve(
+        request.app.state.store,
+        request.cookies.get(COOKIE),
+        _bearer(request.headers.get("authorization")),
+    )
+    if caller is None:
+        return {"user": None}
+    return {"user": {"id": caller.id, "name": caller.name, "role": str(caller.role)}}
 
 
 @router.get("/api/me", summary="Who is logged in")
