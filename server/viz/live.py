@@ -62,6 +62,8 @@ async def follow_live(view: SceneView, telemetry: RunTelemetry, run) -> ViewStat
                 # Viser serializes on its own loop; the calls that queue it still cost ~1 ms a
                 # frame, kept off the web server's loop. This task waits, so state holds still.
                 await asyncio.to_thread(_draw, view, state)
+        if state.version != drawn_version:  # the last frames came with the end
+            await asyncio.to_thread(_draw, view, state)
     finally:
         viewer.close()
     return state

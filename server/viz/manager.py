@@ -19,6 +19,7 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import logging
+import threading
 import time
 from collections.abc import AsyncIterator
 from dataclasses import dataclass, field
@@ -56,7 +57,10 @@ class VizSession:
     watchers: int = 0
     feed: asyncio.Task | None = None
     player: ReplayPlayer | None = None
-    opened_s: float = field(default_factory=time.monotonic)
+    stopped: bool = False
+    # Held while the replay is set up and while stopping, so a server is never stopped halfway
+    # through building its replay (the live feed's end and an idle stop can meet).
+    lock: threading.Lock = field(default_factory=threading.Lock)
 
     @property
     def port(self) -> int:
@@ -64,20 +68,25 @@ class VizSession:
 
     def start_replay(self) -> None:
         """Replay the recording in this scene (blocking: loads the file)."""
-        try:
-            recording = load_recording(self.run_dir / RECORDING_FILE)
-        except RecordingError as error:
-            self.mode = Mode.NO_RECORDING
-            self.view.set_status(f"**no replay**: {error}")
-            return
-        self.player = ReplayPlayer(self.server, self.view, recording)
-        self.mode = Mode.REPLAY
+        with self.lock:
+            if self.stopped:
+                return
+            try:
+                recording = load_recording(self.run_dir / RECORDING_FILE)
+            except RecordingError as error:
+                self.mode = Mode.NO_RECORDING
+                self.view.set_status(f"**no replay**: {error}")
+                return
+            self.player = ReplayPlayer(self.server, self.view, recording)
+            self.mode = Mode.REPLAY
 
     def stop(self) -> None:
         """Blocking: joins the player and viser's threads."""
-        if self.player is not None:
-            self.player.close()
-        self.server.stop()
+        with self.lock:
+            self.stopped = True
+            if self.player is not None:
+                self.player.close()
+            self.server.stop()
 
 
 def _quiet_viser() -> None:
@@ -193,7 +202,7 @@ class VizManager:
             await self.stop(run_id)
         return idle
 
-    async def stop(self, run_id: str) -> bool:
+    async def stop(self, run_id: str, why: str = "idle") -> bool:
         session = self.sessions.pop(run_id, None)
         self._opening.pop(run_id, None)
         if session is None:
@@ -203,7 +212,7 @@ class VizManager:
             with contextlib.suppress(BaseException):
                 await session.feed
         await asyncio.to_thread(session.stop)
-        log.info("run %s: 3D view stopped (idle)", run_id)
+        log.info("run %s: 3D view stopped (%s)", run_id, why)
         return True
 
     async def close(self) -> None:
@@ -213,4 +222,4 @@ class VizManager:
             with contextlib.suppress(BaseException):
                 await self._reaper
         for run_id in list(self.sessions):
-            await self.stop(run_id)
+            await self.stop(run_id, "shutting down")

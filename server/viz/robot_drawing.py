@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from server.sim.robots.base import RobotModel
 from server.viz.meshes import transformed, unit_box, unit_cylinder, yaw_wxyz
+from server.viz.view_state import SensorFrame
 
 ROBOT_NODE = "/robot"
 BODY_RGB = (60, 110, 200)
@@ -109,10 +110,10 @@ class RobotDrawing:
         pose: tuple[float, float, float] | None,
         leds_rgb: tuple[int, int, int] | None,
         buzzer_on: bool,
-        sensor_frames: dict[str, tuple[float, float, float, float]],
+        sensor_frames: dict[str, SensorFrame],
     ) -> None:
         """Pose (x [m], y [m], yaw [rad]); LED colour (None: never set); buzzer; sensor frames
-        as (x, y, heading [rad], sign) in the robot frame (see `view_state.SensorFrame`)."""
+        in the robot frame."""
         if pose is not None and self._changed("pose", pose):
             x, y, yaw = pose
             self.root.position = (x, y, 0.0)
@@ -124,7 +125,7 @@ class RobotDrawing:
         if self.buzzer is not None and self._changed("buzzer", buzzer_on):
             self.buzzer.visible = buzzer_on
         height = self.robot.geometry.height_m
-        for frame, (x, y, heading, _sign) in sensor_frames.items():
+        for frame, mount in sensor_frames.items():
             block = self.sensor_blocks.get(frame)
             if block is None:
                 block = self.scene.add_box(
@@ -133,7 +134,6 @@ class RobotDrawing:
                     dimensions=(SENSOR_BLOCK_M, SENSOR_BLOCK_M, SENSOR_BLOCK_M / 2),
                 )
                 self.sensor_blocks[frame] = block
-            placed = (x, y, heading)
-            if self._changed(f"frame:{frame}", placed):
-                block.position = (x, y, height + SENSOR_BLOCK_M / 4)
-                block.wxyz = yaw_wxyz(heading)
+            if self._changed(f"frame:{frame}", mount):
+                block.position = (mount.x, mount.y, height + SENSOR_BLOCK_M / 4)
+                block.wxyz = yaw_wxyz(mount.heading)

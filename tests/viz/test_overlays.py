@@ -1,0 +1,65 @@
+"""Overlays on a real viser scene: sensor nodes, the chunked trail, path, lookahead, goal."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from server.viz.overlays import (
+    TRAIL_CHUNK_POINTS,
+    Overlays,
+    lookahead_point,
+    node_name,
+    polyline_segments,
+)
+from server.viz.rays import SensorDrawing
+
+
+def test_lookahead_walks_along_the_plan_from_the_nearest_point():
+    plan = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0)]
+    assert lookahead_point(plan, 0.2, 0.3, 0.5) == pytest.approx((0.5, 0.0))
+    assert lookahead_point(plan, 0.9, 0.1, 0.5) == pytest.approx((1.0, 0.5))
+    assert lookahead_point(plan, 1.0, 0.9, 5.0) == pytest.approx((1.0, 1.0))  # the end
+    assert lookahead_point([], 0.0, 0.0) is None
+
+
+def test_names_and_polylines():
+    assert node_name("ultrasonic/range_0") == "ultrasonic_range_0"
+    segments = polyline_segments([(0, 0), (1, 0), (1, 1)], 0.5)
+    assert segments.shape == (2, 2, 3) and (segments[:, :, 2] == 0.5).all()
+    assert segments[1].tolist() == [[1, 0, 0.5], [1, 1, 0.5]]
+
+
+def test_the_trail_seals_chunks_and_starts_over_when_its_start_changes(viser_server):
+    overlays = Overlays(viser_server.scene, 0.1)
+    trail = [(i * 0.01, 0.0) for i in range(2 * TRAIL_CHUNK_POINTS + 10)]
+    overlays.draw_trail(trail[:50])
+    assert viser_server.scene.get_handle_by_name("/trail/tail") is not None
+    overlays.draw_trail(trail)
+    assert len(overlays._trail_sealed) == 2
+    tail = viser_server.scene.get_handle_by_name("/trail/tail")
+    assert len(tail.points) == 9  # ten points after the sealed ones: nine segments
+    overlays.draw_trail(trail[300:])  # the oldest points fell off: redrawn from scratch
+    assert overlays._trail_sealed == []
+    assert viser_server.scene.get_handle_by_name("/trail/0") is None
+    assert len(viser_server.scene.get_handle_by_name("/trail/tail").points) == len(trail) - 301
+
+
+def test_sensors_path_and_goal(viser_server):
+    scene = viser_server.scene
+    overlays = Overlays(scene, 0.2)
+    cone = SensorDrawing("ultrasound", np.array([[0, 0, 1, 0.0]] * 3), np.zeros((0, 2)))
+    scan = SensorDrawing("scan", np.zeros((0, 4)), np.array([[1.0, 2.0], [3.0, 4.0]]))
+    overlays.draw_sensors({"ultrasonic/range_0": cone, "scan": scan})
+    assert scene.get_handle_by_name("/sensors/scan").points.shape == (2, 3)
+    overlays.draw_sensors({"scan": scan})
+    assert scene.get_handle_by_name("/sensors/ultrasonic_range_0").visible is False
+    plan = [(0.0, 0.0), (1.0, 0.0)]
+    overlays.draw_path(plan, (0.0, 0.0, 0.0), None)
+    assert scene.get_handle_by_name("/plan").points.shape == (1, 2, 3)
+    assert tuple(scene.get_handle_by_name("/lookahead").position[:2]) == pytest.approx((0.35, 0))
+    overlays.draw_path(plan, (0.0, 0.0, 0.0), (0.7, 0.1))  # a node's own lookahead wins
+    assert tuple(scene.get_handle_by_name("/lookahead").position[:2]) == pytest.approx((0.7, 0.1))
+    overlays.draw_goal((2.0, 3.0, 0.5))
+    goal = scene.get_handle_by_name("/goal")
+    assert tuple(goal.position) == pytest.approx((2.0, 3.0, 0.0)) and goal.visible
