@@ -4,10 +4,10 @@
 
 import { api } from "../common/api.js";
 import { byId, fill, h, svg } from "../common/dom.js";
-import { app, on } from "./state.js";
+import { app, emit, on } from "./state.js";
 
 const REFRESH_MS = 2000; // [ms] while the run is live and this panel is open
-const COLUMN_GAP = 70; // [px] between layers
+const COLUMN_GAP = 56; // [px] between layers
 const ROW = 54; // [px] between vertices of a layer
 const CHAR = 7.2; // [px] width of a character at the graph's font size
 
@@ -59,6 +59,7 @@ async function refresh() {
     if (app.run?.id !== run.id) return;
     last = graph;
     draw(graph);
+    for (const topic of graph.topics) emit("run-topic", { topic: topic.name, msg_type: topic.type });
   } catch (error) {
     if (app.run?.id === run.id) status.textContent = `No graph: ${error.message}`;
   }

@@ -74,10 +74,10 @@ export function initPlots() {
     if (selected) want(OWNER, selected, PLOT_RATE_HZ);
   });
   on("run-topic", ({ topic, msg_type }) => {
-    if (!topics.has(topic)) {
-      topicEntry(topic, msg_type);
-      renderTopics();
-    }
+    const known = topics.get(topic);
+    if (known && (known.type || !msg_type)) return;
+    topicEntry(topic, msg_type).type = msg_type;
+    renderTopics();
   });
   on("telemetry", ({ frame }) => receive(frame));
   on("run-ended", ({ run }) => loadRecording(run));
