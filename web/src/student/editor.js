@@ -96,9 +96,12 @@ export function initEditor({ run }) {
   });
 }
 
-/** The code of every node, in tab order: what a run is started with. */
+/** The code of every node, in tab order: what a run is started with. An emptied file is left
+ * out (files cannot be deleted from a workspace). */
 export function nodes() {
-  return [...files.values()].map((file) => ({ name: nodeOf(file.filename), code: code(file) }));
+  return [...files.values()]
+    .map((file) => ({ name: nodeOf(file.filename), code: code(file) }))
+    .filter((node) => node.code.trim() !== "");
 }
 
 /** Edited since the last save (starter code nobody touched is not saved). */
@@ -125,9 +128,19 @@ async function load(name) {
     return;
   }
   if (workspace !== name) return; // another workspace was chosen meanwhile
-  const loaded = listing.files.length ? listing.files : [{ filename: "controller.py", version: 0, code: template() }];
+  const loaded = merged(listing.files);
   for (const entry of loaded) addFile(entry.filename, entry.code, entry.version, entry.saved_at);
   show(loaded[0].filename);
+}
+
+/** The saved files, with the starter files not saved yet (the server lists only saved files
+ * once any is saved), in the starter's order; a template for an empty free-play workspace. */
+function merged(saved) {
+  const starter = (app.target?.exercise?.starter || []).map((s) => ({ filename: fileOf(s.name), version: 0, code: s.code }));
+  const byName = new Map(saved.map((f) => [f.filename, f]));
+  const files = starter.map((s) => byName.get(s.filename) || s);
+  for (const file of saved) if (!starter.some((s) => s.filename === file.filename)) files.push(file);
+  return files.length ? files : [{ filename: "controller.py", version: 0, code: template() }];
 }
 
 function addFile(filename, text, version, savedAt) {
