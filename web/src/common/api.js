@@ -33,7 +33,11 @@ export async function api(path, { method = "GET", body, signal } = {}) {
     if (error.name === "AbortError") throw error;
     throw new ApiError(0, "the server does not answer; check that it is running and reload");
   }
-  if (!response.ok) throw new ApiError(response.status, await detailOf(response));
+  if (!response.ok) {
+    // A session that ended (logged out elsewhere, token renewed): the page shows the way back.
+    if (response.status === 401) window.dispatchEvent(new CustomEvent("robodojo:logged-out"));
+    throw new ApiError(response.status, await detailOf(response));
+  }
   const type = response.headers.get("content-type") || "";
   return type.includes("json") ? response.json() : response.text();
 }

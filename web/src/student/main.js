@@ -47,6 +47,13 @@ function who(me) {
   );
 }
 
+/** The session ended while the page was open: say so, and leave the code on screen. */
+function loggedOut() {
+  const message = byId("run-message");
+  fill(message, "Your session has ended, so nothing can be saved or run: open your invite link again (copy any unsaved code first).");
+  message.hidden = false;
+}
+
 async function boot() {
   try {
     app.me = await api("/api/me");
@@ -65,6 +72,7 @@ async function boot() {
   for (const world of worlds) app.worlds.set(world.id, world);
   for (const exercise of exercises) app.exercises.set(exercise.id, exercise);
   who(app.me);
+  window.addEventListener("robodojo:logged-out", loggedOut);
 
   initEditor({ run: start });
   initVersions();
