@@ -167,8 +167,11 @@ function edgePath({ from, to, label }) {
   if (x2 > x1) {
     const bend = (x2 - x1) / 2;
     d = `M${x1},${from.cy} C${x1 + bend},${from.cy} ${x2 - bend},${to.cy} ${x2},${to.cy}`;
-    labelX = (x1 + x2) / 2;
-    labelY = (from.cy + to.cy) / 2 - 4;
+    // The label sits 70% along the curve, where edges fanning out of one node have parted.
+    const t = 0.7;
+    const [a, b, c, e] = [(1 - t) ** 3, 3 * (1 - t) ** 2 * t, 3 * (1 - t) * t ** 2, t ** 3];
+    labelX = a * x1 + b * (x1 + bend) + c * (x2 - bend) + e * x2;
+    labelY = (a + b) * from.cy + (c + e) * to.cy - 4;
   } else {
     // Backwards (a cycle): out of the right side, around below, into the left side.
     const low = Math.max(from.cy, to.cy) + ROW * 0.7;

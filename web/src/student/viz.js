@@ -10,7 +10,6 @@ const panel = byId("panel-viz");
 let shownRun = null; // the run whose view the panel holds
 
 export function initViz() {
-  panel.dataset.testid = "viz-panel";
   on("target", () => {
     shownRun = null;
     fill(panel, h("p", { class: "hint" }, "Run once to see it in 3D."));
