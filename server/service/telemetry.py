@@ -45,6 +45,8 @@ MAX_SUBSCRIPTIONS = 64  # per viewer: more topics than any robot here has
 MAX_TOPIC_CHARS = 256  # a topic name longer than this is a client bug, not a topic
 MAX_VIEWERS_PER_RUN = 256  # a class watching one demo run; each costs a wake-up per message
 LATENCIES_KEPT = 10_000  # delivery latency samples per run, for p50/p99 in benchmarks
+VIEWER_LATENCIES_KEPT = 1_000  # per viewer: 100 viewers must not hold a million floats
+RATE_BURST = 0.5  # [frames] a late frame may be followed this much sooner than one period
 KEEP_AFTER_END_S = 300.0  # [s] a viewer reconnecting after a blip still sees how it ended
 
 
@@ -231,7 +233,7 @@ class Viewer:
         self._wake_pending = False  # a _wake is scheduled on the loop and has not run yet
         self._closed = False
         self._finished = False
-        self.latencies_s: deque[float] = deque(maxlen=LATENCIES_KEPT)
+        self.latencies_s: deque[float] = deque(maxlen=VIEWER_LATENCIES_KEPT)
 
     # ----------------------------------------------------------------------------- subscriptions
     def subscribe(self, topic: str, max_rate_hz: float) -> None:
@@ -327,7 +329,14 @@ class Viewer:
                 continue
             frames.append(self._telemetry_frame(topic, sample, subscription))
             subscription.sent_seq = sample.seq
-            subscription.next_allowed_s = now_s + subscription.period_s
+            # A schedule, not "one period after the last send": a topic published at the
+            # viewer's own rate then goes out as it arrives instead of waiting up to a period
+            # for each sample (the arrival jitter would otherwise make the wait random, 0-50 ms
+            # at 20 Hz). Never more than RATE_BURST frames above the rate over any stretch.
+            subscription.next_allowed_s = (
+                max(subscription.next_allowed_s, now_s - RATE_BURST * subscription.period_s)
+                + subscription.period_s
+            )
             latency_s = time.monotonic() - sample.received_s
             self.latencies_s.append(latency_s)
             self.telemetry._latencies_s.append(latency_s)

@@ -76,7 +76,7 @@ def run_out(record: RunRecord, service: RunService, with_code: bool = False) -> 
         out["code"] = record.code
     if active is not None:
         out["nodes_live"] = {
-            name: {"period": slot.metrics.summary().get("period")}
+            name: {"period": slot.metrics.period.recent_summary()}
             for name, slot in active.run.slots.items()
         }
     return out
