@@ -47,6 +47,22 @@ function who(me) {
   );
 }
 
+/** The logged-in user, or null: GET /api/session never answers 401 (a browser logs every 401
+ * as an error); a server without it (405) is asked /api/me. */
+async function whoIsIn() {
+  try {
+    return (await api("/api/session")).user;
+  } catch (error) {
+    if (error.status !== 405) throw error;
+  }
+  try {
+    return await api("/api/me");
+  } catch (error) {
+    if (error.status === 401) return null;
+    throw error;
+  }
+}
+
 /** The session ended while the page was open: say so, and leave the code on screen. */
 function loggedOut() {
   const message = byId("run-message");
@@ -56,9 +72,13 @@ function loggedOut() {
 
 async function boot() {
   try {
-    app.me = await api("/api/me");
+    app.me = await whoIsIn();
   } catch (error) {
-    gate(error.status === 401 ? null : `The lab cannot be reached: ${error.message}`);
+    gate(`The lab cannot be reached: ${error.message}`);
+    return;
+  }
+  if (!app.me) {
+    gate(null);
     return;
   }
   let robots, worlds, exercises;
