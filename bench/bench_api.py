@@ -29,10 +29,9 @@ with its on_message time and adds GET /bench/delivery-latencies (instructor only
 --tracemalloc lists where the server's Python heap grew during the window (it slows the server
 several times over, so use a small load and ignore that run's latencies).
 
-Reading the delivery numbers: a viewer's next frame may go out no sooner than one period after
-its last one was sent (server/service/telemetry.py), so at --rate equal to the topic's 20 Hz
-each frame waits for up to a period, and delivery spreads evenly over 0-50 ms with a sample
-overwritten whenever the wait wraps round. --rate 60 shows the delivery path without that wait.
+Reading the delivery numbers: a viewer's rate limit keeps a schedule (server/service/
+telemetry.py), so a topic published at the viewer's own rate goes out as it arrives; before that
+change, each frame waited up to a period and delivery spread evenly over 0-50 ms at 20 Hz.
 
 Usage: python bench/bench_api.py [--runs 20] [--viewers 100] [--rate 20] [--duration 60]
        [--warmup 10] [--http-rate 10] [--no-probe | --tracemalloc]
