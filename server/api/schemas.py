@@ -31,6 +31,7 @@ class RunCreate(Strict):
     clock: Literal["lockstep", "realtime"] | None = None
     duration: float | None = Field(None, gt=0, le=86400, description="[s] of robot time")
     seed: int | None = Field(None, ge=0, le=2**31 - 1)
+    teleop: bool = Field(False, description="drive with the arrow keys (adds the teleop node)")
 
 
 class RunCommand(Strict):

@@ -61,9 +61,40 @@ def worlds() -> list[dict]:
                 "title": world.title,
                 "robots": list(world.robots),
                 "bounds": list(world.bounds),
+                # Geometry for a top-down map [m]: walls and box edges as segments, boxes,
+                # cylinders (plants, posts), floor tape, lights and the named start poses.
+                "segments": _rounded(world.segments),
+                "boxes": _rounded(world.boxes),
+                "circles": [
+                    [*_rounded(row), kind]
+                    for row, kind in zip(
+                        world.circles,
+                        world.circle_kind or ("post",) * len(world.circles),
+                        strict=False,
+                    )
+                ],
+                "tape": [
+                    [*_rounded(row), round(float(width), 4)]
+                    for row, width in zip(world.tape_segments, world.tape_width, strict=True)
+                ],
+                "lights": [
+                    {"name": light.name, "x": light.x, "y": light.y, "movable": light.movable}
+                    for light in world.lights
+                ],
+                "spawns": [
+                    {"name": spawn.name, "x": spawn.x, "y": spawn.y, "yaw": spawn.yaw}
+                    for spawn in world.spawns
+                ],
             }
         )
     return result
+
+
+def _rounded(values) -> list:
+    """A numpy row (or table of rows) as plain lists, to a tenth of a millimetre."""
+    if getattr(values, "ndim", 1) == 2:
+        return [_rounded(row) for row in values]
+    return [round(float(v), 4) for v in values]
 
 
 def check_robot(robot_id: str) -> None:

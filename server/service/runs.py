@@ -54,6 +54,7 @@ class RunRequest:
     clock: Clock | None
     duration_s: float | None
     seed: int | None
+    teleop: bool = False  # the teleop built-in: arrow keys from the browser drive the robot
 
 
 @dataclass
@@ -158,6 +159,8 @@ class RunService:
                 duration_s=duration if duration is not None else 30.0,
                 seed=request.seed or 0,
             )
+        if request.teleop and "teleop" not in spec.builtin_nodes:
+            spec = _replace(spec, builtin_nodes=(*spec.builtin_nodes, "teleop"))
         spec.validate()  # RunSpecError: the caller turns it into a 422
         return spec
 

@@ -44,6 +44,7 @@ def set_state(db: Db, run_id: str, state: str, reason: str = "") -> None:
 class RunFilter:
     user_id: str | None = None
     exercise_id: str | None = None
+    robot: str | None = None
     state: str | None = None  # a RunState, or "active" for every state before the end
     since: float | None = None  # [epoch s] created at or after
     until: float | None = None  # [epoch s] created before
@@ -58,6 +59,8 @@ def listing(db: Db, where: RunFilter) -> tuple[list[RunRecord], int]:
         conditions.append(RunRecord.user_id == where.user_id)
     if where.exercise_id is not None:
         conditions.append(RunRecord.exercise_id == where.exercise_id)
+    if where.robot is not None:
+        conditions.append(RunRecord.robot == where.robot)
     if where.state == "active":  # every state before the end
         conditions.append(RunRecord.state.in_(ACTIVE_STATES))
     elif where.state is not None:

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import time
 
-from sqlalchemy import func, select
+from sqlalchemy import delete, func, select
 from sqlalchemy.orm import Session as Db
 
 from server.store.models import CodeVersion
@@ -87,3 +87,15 @@ def get_version(
             CodeVersion.version == version,
         )
     )
+
+
+def delete_file(db: Db, user_id: str, workspace: str, filename: str) -> int:
+    """Remove a file with its history (the student asked to); returns the versions removed."""
+    result = db.execute(
+        delete(CodeVersion).where(
+            CodeVersion.user_id == user_id,
+            CodeVersion.workspace == workspace,
+            CodeVersion.filename == filename,
+        )
+    )
+    return result.rowcount or 0

@@ -137,3 +137,26 @@ def test_lockstep_run_finishes_with_metrics_and_csv(lab):
     assert "Distance.csv" in [f["name"] for f in csvs]
     text = student.get(f"/api/runs/{run['id']}/csv/Distance.csv").text
     assert text.splitlines()[0] == "time_s,data" and len(text.splitlines()) > 150
+
+
+def test_worlds_carry_their_geometry_for_a_map(lab):
+    worlds = {w["id"]: w for w in lab.student("mapper").get("/api/worlds").json()}
+    arena = worlds["light_arena"]
+    assert arena["lights"] == [{"name": "lamp", "x": 1.0, "y": 1.6, "movable": True}]
+    assert len(arena["segments"]) == 4 and all(len(s) == 4 for s in arena["segments"])
+    assert worlds["crop_rows"]["circles"][0][-1] == "plant"
+    assert len(worlds["line_track"]["tape"]) > 10
+    assert worlds["office"]["spawns"][0]["name"] == "start"
+
+
+def test_my_runs_filter_by_robot(lab):
+    student = lab.student("filter")
+    code = "RATE_HZ = 10\n\n\ndef step(obs):\n    return None\n"
+    started = student.post(
+        "/api/runs",
+        json={"robot": "ir_scout", "world": "obstacle_maze", "duration": 0.5,
+              "nodes": [{"name": "idle", "code": code}]},
+    )  # fmt: skip
+    wait_for_end(student, started.json()["id"])
+    assert student.get("/api/runs", params={"robot": "ir_scout"}).json()["total"] == 1
+    assert student.get("/api/runs", params={"robot": "crowbot"}).json()["total"] == 0

@@ -148,3 +148,25 @@ def test_an_exercise_run_sends_its_checks_before_the_end(lab):
     assert 0.0 <= checks["score"] <= 1.0
     stored = wait_for_end(student, run_id)
     assert stored["checks"] == checks["checks"] and stored["score"] == checks["score"]
+
+
+def test_a_free_run_with_teleop_is_driven_by_arrow_keys(lab):
+    student = lab.student("driver")
+    code = "RATE_HZ = 10\n\n\ndef step(obs):\n    return None\n"
+    answer = student.post(
+        "/api/runs",
+        json={"robot": "crowbot", "world": "wall_approach", "clock": "realtime", "duration": 20,
+              "teleop": True, "nodes": [{"name": "idle", "code": code}]},
+    )  # fmt: skip
+    assert answer.status_code == 201, answer.text
+    run_id = answer.json()["id"]
+    with live(lab, student, run_id) as ws:
+        ws.send(json.dumps({"id": "k", "op": "teleop", "key": "up", "pressed": True}))
+        frames = frames_for(ws, 2.0)
+        ws.send(json.dumps({"id": "w", "op": "teleop", "key": "warp"}))
+        frames += frames_for(ws, 0.5)
+    assert answer_to(frames, "k") == {"type": "ack", "id": "k"}
+    assert "teleop knows the keys" in answer_to(frames, "w")["detail"]
+    student.post(f"/api/runs/{run_id}/stop")
+    run = wait_for_end(student, run_id)
+    assert run["metrics"]["distance_travelled_m"] > 0.05  # the up arrow drove it forward

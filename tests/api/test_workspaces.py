@@ -24,8 +24,23 @@ def test_a_workspace_starts_from_the_starter_code_and_keeps_every_version(lab):
     restored = student.post(f"{url}/versions/1/restore").json()
     assert (restored["version"], restored["code"]) == (3, "v = 1\n")
     files = student.get("/api/workspaces/ir_scout_avoidance").json()["files"]
-    assert [(f["filename"], f["version"]) for f in files] == [("planner.py", 3)]
+    versions = {f["filename"]: f["version"] for f in files}
+    assert versions.pop("planner.py") == 3
+    assert set(versions) == set(starter) - {"planner.py"} and set(versions.values()) == {0}
     assert student.get(f"{url}/versions/9").status_code == 404
+
+
+def test_deleting_a_file_removes_it_and_its_history(lab):
+    student = lab.student("tidy")
+    url = "/api/workspaces/crowbot/files/scratch.py"
+    student.put(url, json={"code": "a = 1\n"})
+    student.put(url, json={"code": "a = 2\n"})
+    other = lab.student("untidy")
+    assert other.delete(url).status_code == 404  # not theirs: nothing to delete
+    answer = student.delete(url)
+    assert answer.json() == {"ok": True, "versions_removed": 2}
+    assert student.get("/api/workspaces/crowbot").json()["files"] == []
+    assert student.delete(url).status_code == 404
 
 
 def test_a_workspace_must_name_an_exercise_or_a_robot(lab):

@@ -1,7 +1,8 @@
 """`/api/runs/{id}/live`: one websocket per viewer of a run.
 
 Server -> client frames (JSON):
-    {"type": "snapshot", "state", "reason", "time_s", "topics": {name: type}}   first
+    {"type": "snapshot", "run_id", "state", "reason", "time_s", "topics": {name: type}}
+    {"type": "topic", "topic", "msg_type"}                      a topic's first message
     {"type": "telemetry", "topic", "msg_type", "time_s", "msg": {...}, "dropped": n}
     {"type": "log", "node", "line"} / {"type": "state", "state", "reason", "time_s"}
     {"type": "checks", "checks": [...], "score"}                                 exercises

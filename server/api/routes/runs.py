@@ -70,6 +70,8 @@ def run_out(record: RunRecord, service: RunService, with_code: bool = False) -> 
             "logs": f"/api/runs/{record.id}/logs",
             "artifacts": f"/api/runs/{record.id}/artifacts",
             "csv": f"/api/runs/{record.id}/csv",
+            "graph": f"/api/runs/{record.id}/graph",
+            "viz": f"/api/runs/{record.id}/viz/",
         },
     }
     if with_code:
@@ -122,6 +124,7 @@ def create(body: RunCreate, request: Request, caller: Caller = Depends(current_u
         world=body.world,
         exercise=entry,
         nodes=tuple((node.name, node.code) for node in body.nodes),
+        teleop=body.teleop,
         clock=Clock(body.clock) if body.clock else None,
         duration_s=body.duration,
         seed=body.seed,
@@ -135,10 +138,13 @@ def listing(
     request: Request,
     caller: Caller = Depends(current_user),
     exercise: str | None = Query(None, max_length=64),
+    robot: str | None = Query(None, max_length=32, description="only runs of this robot"),
     limit: int = Query(50, ge=1, le=500),
     offset: int = Query(0, ge=0, le=10**9),
 ) -> dict:
-    where = run_store.RunFilter(user_id=caller.id, exercise_id=exercise, limit=limit, offset=offset)
+    where = run_store.RunFilter(
+        user_id=caller.id, exercise_id=exercise, robot=robot, limit=limit, offset=offset
+    )
     with request.app.state.store.session() as db:
         rows, total = run_store.listing(db, where)
     service = service_of(request)

@@ -59,12 +59,28 @@ def get_workspace(
     starter = _starter(request, workspace)
     with request.app.state.store.session() as db:
         files = [_version_out(v) for v in store.latest_files(db, caller.id, workspace)]
-    if not files:
-        files = [
-            {"filename": name, "version": 0, "saved_at": None, "bytes": len(code), "code": code}
-            for name, code in starter
-        ]
-    return {"workspace": workspace, "files": files}
+    saved = {f["filename"] for f in files}
+    # Starter files not saved yet (version 0), so a four-node exercise keeps its four files.
+    files += [
+        {"filename": name, "version": 0, "saved_at": None, "bytes": len(code), "code": code}
+        for name, code in starter
+        if name not in saved
+    ]
+    return {"workspace": workspace, "files": sorted(files, key=lambda f: f["filename"])}
+
+
+@router.delete("/{workspace}/files/{filename}", summary="Delete a file and its versions")
+def delete_file(
+    request: Request,
+    workspace: str = WorkspaceId,
+    filename: str = FileName,
+    caller: Caller = Depends(current_user),
+) -> dict:
+    with request.app.state.store.session() as db:
+        removed = store.delete_file(db, caller.id, workspace, _filename(filename))
+    if not removed:
+        raise HTTPException(404, f"no saved file '{filename}' in '{workspace}'")
+    return {"ok": True, "versions_removed": removed}
 
 
 @router.put("/{workspace}/files/{filename}", summary="Save a file (a new version)")
