@@ -23,8 +23,8 @@ from server.viz.world_scene import draw_world
 
 log = logging.getLogger("robodojo.viz")
 SENSOR_HEIGHT_FRACTION = 0.6  # [1] of the robot's height: where rays and scan points are drawn
-CAMERA_BACK = 0.3  # [1] of the world's larger side: the first camera stands this far south
-CAMERA_UP = 1.1  # [1] of the world's larger side, this high: looking down over the walls
+CAMERA_BACK = 0.15  # [1] of the world's larger side: the first camera stands this far south
+CAMERA_UP = 1.2  # [1] of the world's larger side, this high: looking down over the walls
 
 
 class Controls(Protocol):

@@ -18,6 +18,7 @@ from server.sim.world import MAP_OCCUPIED, MAP_UNKNOWN, GridMap, World
 from server.viz.meshes import unit_box, unit_cylinder, yaw_wxyz, yaw_wxyzs
 
 WALL_THICKNESS_M = 0.02  # [m] walls are lines to the simulator; drawn this thick to be seen
+WALL_OPACITY = 0.45  # [1] see-through: a 2 m office wall would hide the robot behind it
 FLOOR_MARGIN_M = 0.3  # [m] floor beyond the world's bounds, so the edge walls stand on it
 FLOOR_THICKNESS_M = 0.01  # [m] top face at z = 0
 MAP_LIFT_M = 0.002  # [m] above the floor, so the map does not flicker against it
@@ -105,11 +106,13 @@ def tape_mesh(world: World) -> dict[int, tuple[np.ndarray, np.ndarray]]:
 
 def map_image(grid: GridMap) -> np.ndarray:
     """The occupancy grid as an RGBA image (height, width, 4): free cells clear, occupied dark,
-    unknown grey; row 0 is the map's top edge (largest y), as images are drawn."""
+    unknown grey. Rows stay in the grid's order (row 0 at the map's origin, smallest y): viser
+    lays an image's first row toward the node's -y (OpenCV's image axes, y down), which is where
+    row 0 belongs; flipping it showed the office's desks mirrored about the corridor."""
     image = np.zeros((grid.height, grid.width, 4), dtype=np.uint8)
     image[grid.data >= MAP_OCCUPIED] = MAP_OCCUPIED_RGBA
     image[grid.data == MAP_UNKNOWN] = MAP_UNKNOWN_RGBA
-    return np.ascontiguousarray(image[::-1])
+    return image
 
 
 @dataclass(frozen=True, slots=True)
@@ -124,7 +127,9 @@ class WorldNodes:
     has_map: bool
 
 
-def _draw_slabs(scene, name: str, slabs: Slabs, rgb: tuple[int, int, int]) -> None:
+def _draw_slabs(
+    scene, name: str, slabs: Slabs, rgb: tuple[int, int, int], opacity: float | None = None
+) -> None:
     vertices, faces = unit_box()
     scene.add_batched_meshes_simple(
         name,
@@ -136,6 +141,7 @@ def _draw_slabs(scene, name: str, slabs: Slabs, rgb: tuple[int, int, int]) -> No
         batched_colors=rgb,
         flat_shading=True,
         lod="off",
+        opacity=opacity,
     )
 
 
@@ -153,9 +159,12 @@ def draw_world(scene, world: World) -> WorldNodes:
     )
     names.append("/world/floor")
     walls, boxes = wall_slabs(world), box_slabs(world)
-    for name, slabs, rgb in (("/world/walls", walls, WALL_RGB), ("/world/boxes", boxes, BOX_RGB)):
+    for name, slabs, rgb, opacity in (
+        ("/world/walls", walls, WALL_RGB, WALL_OPACITY),
+        ("/world/boxes", boxes, BOX_RGB, None),
+    ):
         if len(slabs):
-            _draw_slabs(scene, name, slabs, rgb)
+            _draw_slabs(scene, name, slabs, rgb, opacity)
             names.append(name)
     cylinder_vertices, cylinder_faces = unit_cylinder()
     for kind, indices in cylinder_kinds(world).items():

@@ -59,13 +59,13 @@ def test_boxes_keep_their_size_and_yaw():
     assert slabs.centres[:, 2] == pytest.approx(world.boxes[:, 5] / 2)
 
 
-def test_the_map_image_has_its_top_row_at_the_largest_y():
+def test_the_map_image_keeps_the_grids_row_order():
     grid = load_world("office").grid_map
     image = map_image(grid)
     assert image.shape == (grid.height, grid.width, 4)
     dark = (image[..., :4] == MAP_OCCUPIED_RGBA).all(axis=2)
-    assert np.array_equal(dark[::-1], grid.data >= MAP_OCCUPIED)  # grid row 0 is y = origin
-    assert not dark[-1].any() and (image[-1, :, 3] > 0).all()  # bottom row: unknown margin
+    assert np.array_equal(dark, grid.data >= MAP_OCCUPIED)  # row 0 at y = origin, viser's -y
+    assert not dark[0].any() and (image[0, :, 3] > 0).all()  # the unknown margin
 
 
 def test_tape_quads_are_as_wide_as_the_tape():
