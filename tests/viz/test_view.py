@@ -130,12 +130,24 @@ def test_a_live_run_is_followed_from_its_telemetry_to_its_end(viser_server, laun
     view = SceneView(viser_server, "crowbot", "light_arena", run)
     worker = threading.Thread(target=run.execute)
 
+    async def drag_the_lamp() -> None:
+        while run.time_s < 0.5:
+            await asyncio.sleep(0.01)
+        view.lights._dragged("lamp", SimpleNamespace(phase="end", target=SimpleNamespace(
+            position=(1.5, 0.5, 0.1))))  # fmt: skip
+
     async def main() -> ViewState:
         worker.start()
-        return await follow_live(view, telemetry, run)
+        feed = asyncio.create_task(follow_live(view, telemetry, run))
+        await drag_the_lamp()
+        return await feed
 
     state = asyncio.run(main())
     worker.join()
+    lamp = run.sim.lights[0]
+    assert (lamp.x, lamp.y) == (1.5, 0.5)  # the drag reached the simulation...
+    assert state.lights == run.sim.lights  # ...and came back to the view
+    assert tuple(view.lights.nodes["lamp"].position[:2]) == pytest.approx((1.5, 0.5))
     assert state.time_s == pytest.approx(1.5, abs=0.1)
     assert state.leds_rgb == (255, 0, 0)
     robot = viser_server.scene.get_handle_by_name("/robot")
