@@ -14,6 +14,7 @@ import numpy as np
 from server.viz.meshes import transformed, unit_cylinder, yaw_wxyz
 from server.viz.rays import SensorDrawing
 
+SENSOR_NODE = "/robot/readings"  # below the robot: readings are drawn in its frame
 SENSOR_RGB = {"ultrasound": (255, 150, 30), "infrared": (230, 40, 40), "scan": (0, 200, 220)}
 TRAIL_RGB = (90, 60, 200)
 PLAN_RGB = (30, 170, 60)
@@ -24,7 +25,7 @@ TRAIL_THICKNESS_M = 0.008  # [m]
 PLAN_THICKNESS_M = 0.012  # [m]
 SCAN_POINT_SIZE_M = 0.025  # [m]
 OVERLAY_LIFT_M = 0.01  # [m] trail, plan and goal float this far above the floor
-TRAIL_CHUNK_POINTS = 256  # [-] points per sealed trail node
+TRAIL_CHUNK_POINTS = 64  # [-] points per sealed trail node: the tail resent per frame <= 1.5 KiB
 GOAL_ARROW_M = 0.3  # [m] length of the line showing the goal's yaw
 GOAL_DISC_M = 0.08  # [m] radius of the goal's disc
 LOOKAHEAD_M = 0.35  # [m] along the plan, when no node publishes its own `lookahead` (the
@@ -85,9 +86,11 @@ class Overlays:
         self._goal_shown = None
 
     # ----------------------------------------------------------------------------- sensors
-    def draw_sensors(self, drawings: dict[str, SensorDrawing]) -> None:
+    def draw_sensors(self, drawings: dict[str, SensorDrawing], present: set[str]) -> None:
+        """Update the readings that changed (`drawings`, robot frame: the nodes hang below
+        /robot); hide those whose topic is not in `present` (a replay before its first one)."""
         for topic, drawing in drawings.items():
-            name = f"/sensors/{node_name(topic)}"
+            name = f"{SENSOR_NODE}/{node_name(topic)}"
             colour = SENSOR_RGB.get(drawing.kind, (200, 200, 200))
             if drawing.kind == "scan":
                 points = np.column_stack(
@@ -98,7 +101,8 @@ class Overlays:
                 segments = segments_3d(drawing.segments, self.sensor_height_m)
                 self._update(topic, name, "segments", segments, colour)
         for topic, (node, _) in self.sensor_nodes.items():
-            node.visible = topic in drawings
+            if topic not in present:
+                node.visible = False
 
     def _update(self, topic: str, name: str, kind: str, data: np.ndarray, colour) -> None:
         known = self.sensor_nodes.get(topic)
@@ -106,16 +110,17 @@ class Overlays:
             if known is not None:
                 known[0].visible = False
             return
-        if known is None:
-            if kind == "points":
-                node = self.scene.add_point_cloud(
-                    name, data, colour, point_size=SCAN_POINT_SIZE_M, point_shape="circle"
-                )
-            else:
-                node = self.scene.add_line_segments(name, data, colour, thickness=RAY_THICKNESS_M)
-            self.sensor_nodes[topic] = (node, kind)
+        if known is not None:
+            known[0].points = data
+            known[0].visible = True
             return
-        known[0].points = data
+        if kind == "points":
+            node = self.scene.add_point_cloud(
+                name, data, colour, point_size=SCAN_POINT_SIZE_M, point_shape="circle"
+            )
+        else:
+            node = self.scene.add_line_segments(name, data, colour, thickness=RAY_THICKNESS_M)
+        self.sensor_nodes[topic] = (node, kind)
 
     # ----------------------------------------------------------------------------- trail
     def draw_trail(self, trail: Sequence[tuple[float, float]]) -> None:

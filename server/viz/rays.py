@@ -1,5 +1,6 @@
-"""What each sensor measured, as world-frame geometry for the view: a ranger's cone (its axis and
-edges, as long as the reading), a scan's hit points (LiDAR, the depth camera's slice).
+"""What each sensor measured, as geometry for the view (the view draws it in the robot frame): a
+ranger's cone (its axis and edges, as long as the reading), a scan's hit points (LiDAR, the depth
+camera's slice).
 
 Drawn from the messages themselves, placed by the sensor frames of /tf, so a replay draws them as
 the live view does: a `sensor_msgs/Range` becomes a cone of its `field_of_view`, a
@@ -25,6 +26,7 @@ from server.sim.world import World
 from server.viz.view_state import SensorFrame, ViewState
 
 ULTRASOUND, INFRARED = 0, 1  # sensor_msgs/Range radiation_type
+ROBOT_ORIGIN = (0.0, 0.0, 0.0)  # drawings are made in the robot frame
 
 
 @dataclass(frozen=True, slots=True)
@@ -107,29 +109,44 @@ def _own_rays(
     return np.asarray(sensor.rays(context, message), dtype=np.float64).reshape(-1, 4)
 
 
+def reading_key(state: ViewState, robot: RobotModel, msg: dict[str, Any]) -> tuple:
+    """What a reading's drawing depends on: the message itself and where its frame sits (a
+    servo turns the IR ranger's). Compared with `is`/`==` to skip redrawing what has not changed;
+    holding the message keeps its identity from being reused."""
+    header = msg.get("header") if isinstance(msg, dict) else None
+    frame_id = header.get("frame_id") if isinstance(header, dict) else None
+    return (msg, state.sensor_frames.get(frame_id) if frame_id else None)
+
+
 def sensor_drawings(
-    state: ViewState, robot: RobotModel, sensors: dict[str, Sensor], world: World
+    state: ViewState,
+    robot: RobotModel,
+    sensors: dict[str, Sensor],
+    world: World,
+    topics: set[str] | None = None,
 ) -> dict[str, SensorDrawing]:
-    """Topic -> what to draw, for every sensor reading in `state` that can be drawn."""
-    if state.pose is None:
-        return {}
+    """Topic -> what to draw IN THE ROBOT FRAME (x forward, y left [m]), for every sensor reading
+    in `state` that can be drawn (only `topics`, if given). Drawn below the robot's node, a
+    reading moves with the robot for free and is sent again only when a new message comes."""
     empty_points, empty_segments = np.zeros((0, 2)), np.zeros((0, 4))
     drawings = {}
     for topic, (type_name, msg) in state.latest.items():
+        if topics is not None and topic not in topics:
+            continue
         try:
             if type_name == "sensor_msgs/LaserScan":
                 frame = _frame_of(state, robot, msg)
                 if frame is not None:
-                    points = scan_points(state.pose, frame, msg)
+                    points = scan_points(ROBOT_ORIGIN, frame, msg)
                     drawings[topic] = SensorDrawing("scan", empty_segments, points)
             elif type_name == "sensor_msgs/Range":
                 frame = _frame_of(state, robot, msg)
                 if frame is not None:
                     kind = "infrared" if msg["radiation_type"] == INFRARED else "ultrasound"
-                    cone = range_cone(state.pose, frame, msg)
+                    cone = range_cone(ROBOT_ORIGIN, frame, msg)
                     drawings[topic] = SensorDrawing(kind, cone, empty_points)
             elif topic in sensors:
-                segments = _own_rays(sensors[topic], type_name, msg, state.pose, world)
+                segments = _own_rays(sensors[topic], type_name, msg, ROBOT_ORIGIN, world)
                 if segments is not None:
                     drawings[topic] = SensorDrawing("ultrasound", segments, empty_points)
         except (KeyError, TypeError, ValueError, AttributeError):

@@ -16,7 +16,7 @@ from server.sim.registry import get_robot
 from server.sim.world import load_world
 from server.viz.lights import LightMarkers
 from server.viz.overlays import Overlays
-from server.viz.rays import sensor_drawings
+from server.viz.rays import reading_key, sensor_drawings
 from server.viz.robot_drawing import RobotDrawing
 from server.viz.view_state import ViewState
 from server.viz.world_scene import draw_world
@@ -41,6 +41,10 @@ def floor_point(origin, direction) -> tuple[float, float] | None:
         return None
     t = -origin[2] / direction[2]
     return origin[0] + t * direction[0], origin[1] + t * direction[1]
+
+
+def _same(old: tuple | None, new: tuple) -> bool:
+    return old is not None and old[0] is new[0] and old[1] == new[1]
 
 
 class SceneView:
@@ -71,6 +75,7 @@ class SceneView:
             on_move=self._move_light if controls is not None else None,
         )
         self.pose: tuple[float, float, float] | None = None
+        self._reading_keys: dict[str, tuple] = {}  # topic -> reading_key last drawn
         if controls is not None and self.world.grid_map is not None:
             scene.on_click()(self._clicked)
         self.status = server.gui.add_markdown("")
@@ -78,12 +83,19 @@ class SceneView:
     # ----------------------------------------------------------------------------- drawing
     def draw(self, state: ViewState) -> None:
         """Show `state` (call from one thread at a time)."""
-        drawings = sensor_drawings(state, self.robot, self.sensors, self.world)
+        changed = {
+            topic
+            for topic, (_, msg) in state.latest.items()
+            if not _same(self._reading_keys.get(topic), reading_key(state, self.robot, msg))
+        }
+        drawings = sensor_drawings(state, self.robot, self.sensors, self.world, changed)
+        for topic in changed:
+            self._reading_keys[topic] = reading_key(state, self.robot, state.latest[topic][1])
         with self.server.atomic():
             self.robot_drawing.update(
                 state.pose, state.leds_rgb, state.buzzer_on, state.sensor_frames
             )
-            self.overlays.draw_sensors(drawings)
+            self.overlays.draw_sensors(drawings, set(state.latest))
             self.overlays.draw_trail(state.trail)
             self.overlays.draw_path(state.plan, state.pose, state.lookahead)
             self.overlays.draw_goal(state.goal)

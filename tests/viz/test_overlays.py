@@ -33,16 +33,18 @@ def test_names_and_polylines():
 def test_the_trail_seals_chunks_and_starts_over_when_its_start_changes(viser_server):
     overlays = Overlays(viser_server.scene, 0.1)
     trail = [(i * 0.01, 0.0) for i in range(2 * TRAIL_CHUNK_POINTS + 10)]
-    overlays.draw_trail(trail[:50])
+    overlays.draw_trail(trail[: TRAIL_CHUNK_POINTS // 2])
     assert viser_server.scene.get_handle_by_name("/trail/tail") is not None
     overlays.draw_trail(trail)
     assert len(overlays._trail_sealed) == 2
     tail = viser_server.scene.get_handle_by_name("/trail/tail")
     assert len(tail.points) == 9  # ten points after the sealed ones: nine segments
-    overlays.draw_trail(trail[300:])  # the oldest points fell off: redrawn from scratch
-    assert overlays._trail_sealed == []
-    assert viser_server.scene.get_handle_by_name("/trail/0") is None
-    assert len(viser_server.scene.get_handle_by_name("/trail/tail").points) == len(trail) - 301
+    later = trail[20:]  # the oldest points fell off: redrawn from scratch
+    overlays.draw_trail(later)
+    assert len(overlays._trail_sealed) == 1
+    assert viser_server.scene.get_handle_by_name("/trail/1") is None
+    tail = viser_server.scene.get_handle_by_name("/trail/tail")
+    assert len(tail.points) == len(later) - TRAIL_CHUNK_POINTS - 1
 
 
 def test_sensors_path_and_goal(viser_server):
@@ -50,10 +52,13 @@ def test_sensors_path_and_goal(viser_server):
     overlays = Overlays(scene, 0.2)
     cone = SensorDrawing("ultrasound", np.array([[0, 0, 1, 0.0]] * 3), np.zeros((0, 2)))
     scan = SensorDrawing("scan", np.zeros((0, 4)), np.array([[1.0, 2.0], [3.0, 4.0]]))
-    overlays.draw_sensors({"ultrasonic/range_0": cone, "scan": scan})
-    assert scene.get_handle_by_name("/sensors/scan").points.shape == (2, 3)
-    overlays.draw_sensors({"scan": scan})
-    assert scene.get_handle_by_name("/sensors/ultrasonic_range_0").visible is False
+    overlays.draw_sensors(
+        {"ultrasonic/range_0": cone, "scan": scan}, {"ultrasonic/range_0", "scan"}
+    )
+    assert scene.get_handle_by_name("/robot/readings/scan").points.shape == (2, 3)
+    overlays.draw_sensors({}, {"scan"})  # nothing new; the ranger's reading is gone
+    assert scene.get_handle_by_name("/robot/readings/ultrasonic_range_0").visible is False
+    assert scene.get_handle_by_name("/robot/readings/scan").visible
     plan = [(0.0, 0.0), (1.0, 0.0)]
     overlays.draw_path(plan, (0.0, 0.0, 0.0), None)
     assert scene.get_handle_by_name("/plan").points.shape == (1, 2, 3)

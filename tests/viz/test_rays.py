@@ -56,23 +56,26 @@ def test_a_range_is_a_cone_as_long_as_its_reading():
     assert np.hypot(*(far[1, 2:] - far[1, :2])) == pytest.approx(4.0)
 
 
-def test_the_crowbots_distance_is_drawn_by_its_own_sensor():
+def test_the_crowbots_distance_is_drawn_by_its_own_sensor_in_the_robot_frame():
     robot, world = get_robot("crowbot"), load_world("light_arena")
-    state = ViewState(pose=(1.0, 1.0, 0.0))
+    state = ViewState(pose=(1.0, 1.0, 2.0))  # the pose does not matter: robot frame
     state.latest["Distance"] = ("std_msgs/Int32", decoded(Int32(data=50)))
     drawings = sensor_drawings(state, robot, robot.build_sensors(), world)
     segments = drawings["Distance"].segments
     assert len(segments) == 3
-    assert segments[1] == pytest.approx([1 + ULTRASONIC_MOUNT.x_m, 1.0, 1.55, 1.0])
+    assert segments[1] == pytest.approx([ULTRASONIC_MOUNT.x_m, 0.0, 0.55, 0.0])
     half = CONE_FULL_ANGLE_RAD / 2
     dx, dy = segments[2, 2:] - segments[2, :2]
     assert math.atan2(dy, dx) == pytest.approx(half)  # the cone's left edge
 
 
-def test_nothing_is_drawn_before_the_first_pose_and_bad_readings_are_left_out():
+def test_bad_readings_are_left_out_and_only_the_topics_asked_for_are_drawn():
     robot, world = get_robot("turtlebot"), load_world("office")
     state = ViewState()
     state.latest["scan"] = ("sensor_msgs/LaserScan", {"header": {"frame_id": "camera_depth_frame"}})
-    assert sensor_drawings(state, robot, robot.build_sensors(), world) == {}
-    state.pose = (2.0, 1.3, 0.0)
     assert sensor_drawings(state, robot, robot.build_sensors(), world) == {}  # no ranges
+    reading = Range(header=Header(frame_id="ultrasonic_3"), field_of_view=0.26, max_range=4.0)
+    state.latest["ultrasonic/range_3"] = ("sensor_msgs/Range", decoded(reading))
+    sensors = robot.build_sensors()
+    assert set(sensor_drawings(state, robot, sensors, world)) == {"ultrasonic/range_3"}
+    assert sensor_drawings(state, robot, sensors, world, topics={"scan"}) == {}
