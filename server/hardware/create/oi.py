@@ -66,8 +66,10 @@ class PacketSpec:
 # |----|-----------------------|-------|--------|--------|----------------------------------------|
 # |  7 | bumps and wheel drops |   1   |   no   | bits   | bit 0 bump right, 1 bump left,         |
 # |    |                       |       |        |        | 2 wheel drop right, 3 wheel drop left  |
+# | 13 | virtual wall          |   1   |   no   | bool   | in the spec's Stream example           |
 # | 19 | distance              |   2   |  yes   | mm     | since the last report, (left+right)/2  |
 # | 20 | angle                 |   2   |  yes   | deg    | since the last report, ccw +           |
+# | 29 | cliff front left sig. |   2   |   no   | 0-4095 | in the spec's Stream example           |
 # | 35 | OI mode               |   1   |   no   | enum   | OIMode; Safe drops to Passive by itself|
 # | 41 | requested right vel.  |   2   |  yes   | mm/s   | the last Drive Direct right wheel      |
 # | 42 | requested left vel.   |   2   |  yes   | mm/s   | the last Drive Direct left wheel       |
@@ -79,8 +81,10 @@ PACKETS: dict[int, PacketSpec] = {
     spec.packet_id: spec
     for spec in (
         PacketSpec(7, "bumps_wheel_drops", 1, False, "bits"),
+        PacketSpec(13, "virtual_wall", 1, False, "bool"),
         PacketSpec(19, "distance", 2, True, "mm"),
         PacketSpec(20, "angle", 2, True, "deg"),
+        PacketSpec(29, "cliff_front_left_signal", 2, False, "0-4095"),
         PacketSpec(35, "oi_mode", 1, False, "enum"),
         PacketSpec(41, "requested_right_velocity", 2, True, "mm/s"),
         PacketSpec(42, "requested_left_velocity", 2, True, "mm/s"),
