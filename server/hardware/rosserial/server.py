@@ -1,0 +1,429 @@
+"""The rosserial TCP server: what ``rosserial_python serial_node.py tcp`` does, without ROS.
+
+Robots (ros_lib over WiFi, e.g. the CrowBot of 000_32b6074bbd2115c3.txt section 2.4) connect as
+TCP clients to port 11411; each connection gets one ``RosserialSession`` (session.py) and is
+shown to the rest of RoboDojo as a ``RobotConnection`` through a ``RosserialHandler``::
+
+    class Bridge(RosserialHandler):
+        def on_robot_connected(self, robot): ...
+        def on_message(self, robot, topic, message): robot.send("Control", Twist(...))
+
+    with RosserialServer(Bridge(), host="0.0.0.0", port=11411) as server:
+        ...
+
+Threading: the server runs an asyncio event loop in its own thread ("rosserial"). Parsing is
+CPU work, and a garbage flood must not stall the FastAPI loop that serves students' pages and
+websockets; asyncio (rather than a thread per robot) gives cheap per-connection timers, flow
+control and a fixed read buffer (``asyncio.BufferedProtocol``). Handler methods run on that
+thread and must return quickly (hand over with ``loop.call_soon_threadsafe`` or a latest-value
+slot). ``RobotConnection.send``/``stop`` and ``RosserialServer.stop`` may be called from any
+thread; ``send`` checks the topic at once, in the caller's thread, and raises with a sentence.
+
+Unlike rosserial_python (one connection at a time unless forking) it serves up to
+``max_connections`` robots at once; it requests topics at once instead of after 2 s (that sleep
+waits for an Arduino to reboot when its serial port opens; a TCP client is already running).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import itertools
+import logging
+import socket
+import threading
+import time
+from collections import Counter
+from collections.abc import Callable
+
+from sandbox.msgs import Message
+from server.hardware.rosserial.limits import DEFAULT_LIMITS, RosserialLimits
+from server.hardware.rosserial.messages import LogLevel
+from server.hardware.rosserial.session import (
+    Closed,
+    LogLine,
+    MessageReceived,
+    Problem,
+    Ready,
+    RobotTopic,
+    RosserialSession,
+    SessionEvent,
+    SessionState,
+    SyncLost,
+    TopicRefused,
+    TopicRegistered,
+)
+
+DEFAULT_PORT = 11411  # rosserial_python's tcp port; ros_lib's ArduinoTcpHardware default
+logger = logging.getLogger(__name__)
+_LOG_LEVELS = {
+    LogLevel.DEBUG: logging.DEBUG,
+    LogLevel.INFO: logging.INFO,
+    LogLevel.WARN: logging.WARNING,
+    LogLevel.ERROR: logging.ERROR,
+    LogLevel.FATAL: logging.CRITICAL,
+}
+
+
+class RosserialHandler:
+    """What the server tells the rest of RoboDojo; override the methods you need.
+
+    All run on the rosserial thread. ``on_robot_connected`` comes once negotiation is over
+    (``robot.topics`` and ``robot.problems`` are filled); ``on_robot_disconnected`` only follows
+    a connected robot. Problems (refused topics, wrong protocol version...) and lost syncs also
+    arrive as ``on_log`` lines at ERROR and WARN."""
+
+    def on_robot_connected(self, robot: RobotConnection) -> None:
+        """A robot finished negotiating its topics."""
+
+    def on_robot_disconnected(self, robot: RobotConnection, reason: str) -> None:
+        """A connected robot went away; `reason` is a sentence."""
+
+    def on_message(self, robot: RobotConnection, topic: str, message: Message) -> None:
+        """The robot published `message` on `topic`."""
+
+    def on_log(self, robot: RobotConnection, level: LogLevel, line: str) -> None:
+        """The robot logged `line`, or the host has something to say about it."""
+
+
+class RobotConnection:
+    """One robot's TCP connection and its session, as handlers see it."""
+
+    def __init__(
+        self, server: RosserialServer, robot_id: str, peer: tuple[str, int], session
+    ) -> None:
+        self._server = server
+        self.id = robot_id
+        self.peer = peer  # (host, port) of the robot
+        self.session: RosserialSession = session
+        self.connected_at = time.time()  # [s] epoch
+        self.announced = False  # on_robot_connected has been called
+        self.outgoing_dropped = 0  # frames not written: the robot stopped reading
+        self.reads_paused = 0  # times reading paused for the rest of a second (max_bytes_per_s)
+        self._transport: asyncio.Transport | None = None
+
+    @property
+    def state(self) -> SessionState:
+        return self.session.state
+
+    @property
+    def topics(self) -> dict[str, RobotTopic]:
+        """Accepted topics by name, both directions."""
+        return {**self.session.publishers, **self.session.subscribers}
+
+    @property
+    def problems(self) -> list[str]:
+        return list(self.session.problems)
+
+    @property
+    def drops(self) -> Counter[str]:
+        """Incoming frames dropped, by reason."""
+        return self.session.drops
+
+    def send(self, topic: str, message: Message) -> None:
+        """Send `message` on a topic the robot subscribes to; any thread. Raises TopicError or
+        SessionError at once; the frame is written on the rosserial thread (dropped and counted
+        in ``outgoing_dropped`` when the robot has not read the last ~16 KiB)."""
+        frame = self.session.encode(topic, message)
+        self._server._call_on_loop(self._write_frame, frame)
+
+    def stop(self) -> None:
+        """Send the tx-stop frame and close the connection; any thread."""
+        self._server._call_on_loop(self._stop)
+
+    def __repr__(self) -> str:
+        return f"RobotConnection({self.id}, {self.peer[0]}:{self.peer[1]}, {self.state})"
+
+    # --------------------------------------------------------------- rosserial thread only
+    def _write_frame(self, frame: bytes) -> None:
+        transport = self._transport
+        if transport is None or transport.is_closing():
+            return
+        if transport.get_write_buffer_size() > self._server.limits.max_write_buffer_bytes:
+            self.outgoing_dropped += 1
+            return
+        self.session.queue_frame(frame)
+        self._flush()
+
+    def _stop(self) -> None:
+        self._server._dispatch(self, self.session.stop())
+
+    def _flush(self) -> None:
+        data = self.session.data_to_send()
+        transport = self._transport
+        if data and transport is not None and not transport.is_closing():
+            transport.write(data)
+
+
+class _Connection(asyncio.BufferedProtocol):
+    """asyncio glue for one socket: reads into a fixed buffer, feeds the session."""
+
+    def __init__(self, server: RosserialServer) -> None:
+        self._server = server
+        self._buffer = bytearray(server.limits.read_buffer_bytes)
+        self._robot: RobotConnection | None = None
+        self._window_start_s = 0.0
+        self._window_bytes = 0
+
+    def connection_made(self, transport: asyncio.BaseTransport) -> None:
+        assert isinstance(transport, asyncio.Transport)
+        server = self._server
+        peer = transport.get_extra_info("peername") or ("?", 0)
+        if len(server._robots) >= server.limits.max_connections:
+            logger.warning(
+                "rosserial: refused %s:%s, already %d robots connected (max_connections)",
+                peer[0],
+                peer[1],
+                len(server._robots),
+            )
+            transport.abort()
+            return
+        sock = transport.get_extra_info("socket")
+        if sock is not None:
+            with contextlib.suppress(OSError):
+                sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+                sock.setsockopt(socket.SOL_SOCKET, socket.SO_KEEPALIVE, 1)
+        session = RosserialSession(clock_ns=server.clock_ns, limits=server.limits)
+        robot = RobotConnection(server, f"robot-{next(server._ids)}", (peer[0], peer[1]), session)
+        robot._transport = transport
+        self._robot = robot
+        server._robots[robot.id] = robot
+        logger.info("rosserial: %s connected from %s:%s", robot.id, peer[0], peer[1])
+        session.start(time.monotonic())
+        robot._flush()
+
+    def get_buffer(self, sizehint: int) -> memoryview:
+        return memoryview(self._buffer)
+
+    def buffer_updated(self, nbytes: int) -> None:
+        robot = self._robot
+        if robot is None or robot.session.state is SessionState.CLOSED:
+            return
+        now_s = time.monotonic()
+        self._limit_rate(now_s, nbytes)
+        events = robot.session.receive_data(memoryview(self._buffer)[:nbytes], now_s)
+        self._server._dispatch(robot, events)
+
+    def _limit_rate(self, now_s: float, nbytes: int) -> None:
+        """Past max_bytes_per_s, stop reading until the second is over (TCP pushes back)."""
+        if now_s - self._window_start_s >= 1.0:
+            self._window_start_s, self._window_bytes = now_s, 0
+        self._window_bytes += nbytes
+        robot = self._robot
+        if self._window_bytes >= self._server.limits.max_bytes_per_s and robot is not None:
+            transport = robot._transport
+            if transport is not None and transport.is_reading():
+                transport.pause_reading()
+                robot.reads_paused += 1
+                asyncio.get_running_loop().call_later(
+                    max(0.0, self._window_start_s + 1.0 - now_s), self._resume
+                )
+
+    def _resume(self) -> None:
+        robot = self._robot
+        if robot is not None and robot._transport is not None:
+            transport = robot._transport
+            if not transport.is_closing() and not transport.is_reading():
+                transport.resume_reading()
+
+    def eof_received(self) -> bool:
+        return False  # close the transport: the robot closed its side
+
+    def connection_lost(self, exc: Exception | None) -> None:
+        robot = self._robot
+        if robot is None:
+            return
+        reason = f"connection lost: {exc}" if exc else "the robot closed the connection"
+        self._server._dispatch(robot, robot.session.close(reason))
+        self._server._forget(robot)
+
+
+class RosserialServer:
+    """rosserial host over TCP; see the module docstring. ``start()``/``stop()`` or ``with``."""
+
+    def __init__(
+        self,
+        handler: RosserialHandler | None = None,
+        *,
+        host: str = "0.0.0.0",
+        port: int = DEFAULT_PORT,
+        limits: RosserialLimits = DEFAULT_LIMITS,
+        clock_ns: Callable[[], int] = time.time_ns,
+    ) -> None:
+        self.handler = handler or RosserialHandler()
+        self.host = host
+        self._requested_port = port
+        self.limits = limits
+        self.clock_ns = clock_ns
+        self._robots: dict[str, RobotConnection] = {}
+        self._ids = itertools.count(1)
+        self._loop: asyncio.AbstractEventLoop | None = None
+        self._thread: threading.Thread | None = None
+        self._listener: asyncio.Server | None = None
+        self._port: int | None = None
+        self.handler_errors = 0
+
+    # ------------------------------------------------------------------------ any thread
+    @property
+    def port(self) -> int:
+        """The TCP port listened on (the real one when constructed with port=0)."""
+        if self._port is None:
+            raise RuntimeError("the rosserial server is not running; call start() first")
+        return self._port
+
+    @property
+    def running(self) -> bool:
+        return self._thread is not None and self._thread.is_alive()
+
+    def robots(self) -> list[RobotConnection]:
+        """The connections open now (a snapshot)."""
+        return list(self._robots.values())
+
+    def start(self) -> None:
+        """Listen (in the rosserial thread); returns once bound. Raises OSError with the
+        address when the port cannot be bound."""
+        if self._thread is not None:
+            raise RuntimeError("this RosserialServer was already started; make a new one")
+        started = threading.Event()
+        failure: list[BaseException] = []
+        self._thread = threading.Thread(
+            target=self._run, args=(started, failure), name="rosserial", daemon=True
+        )
+        self._thread.start()
+        started.wait()
+        if failure:
+            self._thread.join()
+            error = failure[0]
+            raise OSError(
+                f"rosserial server cannot listen on {self.host}:{self._requested_port}: {error}"
+            ) from error
+
+    def stop(self, timeout_s: float = 5.0) -> None:
+        """Send tx-stop to every robot, close the connections and the listener, end the
+        thread. Safe to call twice."""
+        loop, thread = self._loop, self._thread
+        if loop is None or thread is None or not thread.is_alive():
+            return
+        future = asyncio.run_coroutine_threadsafe(self._shutdown(), loop)
+        with contextlib.suppress(TimeoutError):
+            future.result(timeout_s)
+        loop.call_soon_threadsafe(loop.stop)
+        thread.join(timeout_s)
+
+    def __enter__(self) -> RosserialServer:
+        self.start()
+        return self
+
+    def __exit__(self, *exc_info: object) -> None:
+        self.stop()
+
+    def _call_on_loop(self, function: Callable[..., None], *args: object) -> None:
+        loop = self._loop
+        if loop is None or loop.is_closed():
+            return
+        if threading.current_thread() is self._thread:
+            function(*args)
+        else:
+            with contextlib.suppress(RuntimeError):  # loop closed in between: nothing to do
+                loop.call_soon_threadsafe(function, *args)
+
+    # ------------------------------------------------------------------------ rosserial thread
+    def _run(self, started: threading.Event, failure: list[BaseException]) -> None:
+        loop = asyncio.new_event_loop()
+        self._loop = loop
+        try:
+            try:
+                self._listener = loop.run_until_complete(
+                    loop.create_server(
+                        lambda: _Connection(self),
+                        self.host,
+                        self._requested_port,
+                        reuse_address=True,
+                    )
+                )
+            except OSError as error:
+                failure.append(error)
+                return
+            self._port = self._listener.sockets[0].getsockname()[1]
+            logger.info("rosserial: listening on %s:%d", self.host, self._port)
+            loop.call_later(self.limits.poll_interval_s, self._poll)
+            started.set()
+            loop.run_forever()
+        finally:
+            started.set()
+            with contextlib.suppress(Exception):
+                loop.run_until_complete(loop.shutdown_asyncgens())
+            loop.close()
+
+    async def _shutdown(self) -> None:
+        for robot in list(self._robots.values()):
+            self._dispatch(robot, robot.session.stop())
+        if self._listener is not None:
+            self._listener.close()
+            await self._listener.wait_closed()
+        await asyncio.sleep(0.05)  # transports write their tx-stop and close
+
+    def _poll(self) -> None:
+        now_s = time.monotonic()
+        for robot in list(self._robots.values()):
+            self._dispatch(robot, robot.session.poll(now_s))
+        loop = self._loop
+        if loop is not None and loop.is_running():
+            loop.call_later(self.limits.poll_interval_s, self._poll)
+
+    def _forget(self, robot: RobotConnection) -> None:
+        self._robots.pop(robot.id, None)
+        robot._transport = None
+
+    def _dispatch(self, robot: RobotConnection, events: list[SessionEvent]) -> None:
+        robot._flush()  # answers (time, topic requests) go out before handlers run
+        handler = self.handler
+        for event in events:
+            if isinstance(event, MessageReceived):
+                self._call(handler.on_message, robot, event.topic, event.message)
+            elif isinstance(event, LogLine):
+                logger.log(_LOG_LEVELS[event.level], "rosserial %s: %s", robot.id, event.text)
+                self._call(handler.on_log, robot, event.level, event.text)
+            elif isinstance(event, Ready):
+                robot.announced = True
+                logger.info(
+                    "rosserial: %s ready: publishes %s; subscribes %s%s",
+                    robot.id,
+                    ", ".join(robot.session.publishers) or "nothing",
+                    ", ".join(robot.session.subscribers) or "nothing",
+                    f"; {len(robot.session.problems)} problem(s)" if robot.session.problems else "",
+                )
+                self._call(handler.on_robot_connected, robot)
+            elif isinstance(event, TopicRegistered):
+                topic = event.topic
+                logger.info(
+                    "rosserial %s: setup %s on %s [%s]",
+                    robot.id,
+                    "publisher" if topic.direction == "publishes" else "subscriber",
+                    topic.name,
+                    topic.message_type,
+                )
+            elif isinstance(event, (Problem, SyncLost)):
+                text = event.text if isinstance(event, Problem) else event.reason
+                level = LogLevel.ERROR if isinstance(event, Problem) else LogLevel.WARN
+                logger.log(_LOG_LEVELS[level], "rosserial %s: %s", robot.id, text)
+                self._call(handler.on_log, robot, level, text)
+            elif isinstance(event, TopicRefused):
+                pass  # its sentence follows as a Problem
+            elif isinstance(event, Closed):
+                robot._flush()
+                transport = robot._transport
+                if transport is not None and not transport.is_closing():
+                    transport.close()  # writes what is buffered (the tx-stop), then closes
+                logger.info("rosserial: %s disconnected: %s", robot.id, event.reason)
+                self._forget(robot)
+                if robot.announced:
+                    self._call(handler.on_robot_disconnected, robot, event.reason)
+        robot._flush()  # what handlers sent from this thread
+
+    def _call(self, method: Callable[..., None], *args: object) -> None:
+        try:
+            method(*args)
+        except Exception:
+            self.handler_errors += 1
+            logger.exception("rosserial: handler %s raised", getattr(method, "__name__", method))
