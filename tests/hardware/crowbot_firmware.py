@@ -27,6 +27,7 @@ time requests, and dropping the connection when time sync is not answered.
 
 from __future__ import annotations
 
+import contextlib
 import random
 import select
 import socket
@@ -343,10 +344,8 @@ class CrowBotFirmware:
         with self._write_lock:
             if self._sock is None:
                 return
-            try:
+            with contextlib.suppress(OSError):  # the read side notices and closes
                 self._sock.sendall(data)
-            except OSError:
-                pass  # the read side notices and closes
 
     def _run(self) -> None:
         try:
