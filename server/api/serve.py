@@ -47,6 +47,9 @@ def cmd_serve(args: argparse.Namespace) -> int:
             port=settings.port,
             log_level="info",
             ws_max_size=1024 * 1024,  # [B] a websocket command is tiny; a megabyte is abuse
+            # Telemetry and the 3D view send small JSON/msgpack at up to 60 Hz; compressing each
+            # costs more than it saves on a lab network (viser's big point clouds: ~330 ms).
+            ws_per_message_deflate=False,
             timeout_graceful_shutdown=int(settings.shutdown_grace_s) + 5,
         )
     finally:

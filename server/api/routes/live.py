@@ -18,7 +18,7 @@ Client -> server commands, each answered with an ack or an error carrying its "i
 
 Latest wins: a slow client gets the newest sample at its rate and a count of what it missed;
 nothing queues per client beyond one frame in flight. Someone else's run: closed with code
-4404, as if it did not exist.
+4404, as if it did not exist; no login: 4401.
 """
 
 from __future__ import annotations
@@ -38,6 +38,7 @@ from server.store import runs as run_store
 
 router = APIRouter()
 NOT_FOUND_CODE = 4404  # websocket close code: no such run, or not yours
+NOT_LOGGED_IN_CODE = 4401  # websocket close code: no session cookie or token (as the 3D view)
 COMMANDS_PER_S = 50  # a person clicking and typing; more is a runaway client
 MAX_COMMAND_CHARS = 4096  # a command is a small JSON object
 WAIT_S = 1.0  # [s] the writer wakes at least this often to notice a closed socket
@@ -107,9 +108,11 @@ async def live(websocket: WebSocket, run_id: str) -> None:
 
         record = await run_in_threadpool(lookup)
     await websocket.accept()
+    if caller is None:
+        await websocket.close(code=NOT_LOGGED_IN_CODE, reason="not logged in")
+        return
     if record is None or (record.user_id != caller.id and not caller.is_instructor):
-        reason = "not logged in" if caller is None else "no such run (or it is not yours)"
-        await websocket.close(code=NOT_FOUND_CODE, reason=reason)
+        await websocket.close(code=NOT_FOUND_CODE, reason="no such run (or it is not yours)")
         return
     service = app.state.runs
     try:
