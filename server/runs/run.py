@@ -35,7 +35,7 @@ from server.runs.faults import Faults
 from server.runs.metrics import NodeMetrics
 from server.runs.recorder import Recorder
 from server.runs.result import RunEnd, RunResult
-from server.runs.spec import NodeSpec, RunSpec
+from server.runs.spec import NodeSpec, RunSpec, RunSpecError
 from server.runs.state import RunState, check_transition
 from server.runs.tf import tf_message
 from server.sim import Pose2D, Simulation
@@ -91,8 +91,12 @@ class Run(RunControls):
         out_dir: str | Path,
         run_id: str | None = None,
         observer: RunObserver | None = None,
+        backend: Simulation | None = None,
     ) -> None:
         spec.validate()
+        if backend is not None and spec.clock is not Clock.REALTIME:
+            raise RunSpecError("a run on a real robot needs the realtime clock")
+        self.backend = backend  # a real robot (server/hardware/backend.py), else simulated
         self.observer = observer
         self.spec = spec
         self.launcher = launcher
@@ -155,7 +159,7 @@ class Run(RunControls):
     def _prepare(self) -> None:
         spec = self.spec
         spawn = Pose2D(*spec.initial_pose) if spec.initial_pose else spec.spawn
-        self.sim = Simulation(spec.robot, spec.world, seed=spec.seed, spawn=spawn)
+        self.sim = self.backend or Simulation(spec.robot, spec.world, seed=spec.seed, spawn=spawn)
         self.out_dir.mkdir(parents=True, exist_ok=True)
         self.recorder = Recorder(
             self.out_dir,
@@ -371,12 +375,18 @@ class Run(RunControls):
         to zero velocity, recorded as the run's last command, as a real robot needs."""
         if self.sim is None or self.recorder is None:
             return
+        if self.backend is not None:  # a real robot stops at once, not down a ramp
+            try:
+                self.backend.stop()
+            except Exception:
+                log.exception("run %s: could not stop the robot", self.run_id)
         for name, (msg_type, _) in self.sim.robot.commands.items():
             if msg_type._type != "geometry_msgs/Twist":
                 continue
             zero = msg_type()
             try:
-                self.sim.apply(name, zero)
+                if self.backend is None:  # a real robot was stopped above
+                    self.sim.apply(name, zero)
                 self.record(name, msg_type._type, self.time_ns, zero.serialize())
             except Exception:  # the end must go on whatever the robot says
                 log.exception("run %s: could not command zero velocity on %s", self.run_id, name)
@@ -425,6 +435,8 @@ class Run(RunControls):
             try:
                 published = self.sim.step((time_ns - self.time_ns) / NS)
             except SimulationError as error:
+                if self.backend is not None:
+                    raise RunEnd(RunState.FAILED, f"failed: {error}") from None
                 raise RunEnd(RunState.FAILED, f"failed: the simulation stopped: {error}") from None
             self.time_ns = time_ns
             for item in published:

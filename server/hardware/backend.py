@@ -1,0 +1,175 @@
+"""A real robot in place of the simulator inside a Run: the same topics, names and types as the
+simulated robot of that kind, so the code that ran in simulation runs unchanged.
+
+    robot = HardwareRobot("crowbot", link, limits)       # link: a connected robot (RobotLink)
+    run = Run(spec, launcher, out_dir, backend=robot)    # spec.clock must be realtime
+
+It offers the part of `Simulation`'s interface a Run uses (topics, apply, step, state, ...):
+`step()` hands over what the robot sent since the last call, timed on the run's clock;
+`apply()` passes commands through the safety layer (server/hardware/safety.py) before the link.
+The watchdog runs in `step()`: a node that stops commanding for 500 ms stops the robot. When
+the link drops, `step()` raises `RobotLost` and the run ends "failed: robot disconnected".
+Every end of a run calls `stop()`: zero velocity and LEDs off.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import Protocol
+
+from sandbox.msgs.geometry_msgs import Twist, Vector3
+from server.hardware.safety import (
+    DEFAULT_WATCHDOG_S,
+    MotionLimits,
+    Velocity,
+    VelocityLimiter,
+    Watchdog,
+)
+from server.sim import Pose2D
+from server.sim.registry import get_robot
+from server.sim.robots.base import Direction
+from server.sim.simulation import Published, SimulationError
+from server.sim.state import RobotState
+
+POLL_S = 0.005  # [s] how often a realtime run looks for the robot's messages (200 Hz)
+NO_BOUNDS = (-math.inf, -math.inf, math.inf, math.inf)  # a lab bench has no map edges we know
+LEDS_TOPIC = "Leds"  # the CrowBot's LED topic (firmware); LEDs off at every end
+
+
+class RobotLost(SimulationError):
+    """The connection to the robot is gone; the message says how."""
+
+
+class RobotLink(Protocol):
+    """A connected robot as a protocol adapter presents it (rosserial session, Create driver)."""
+
+    @property
+    def connected(self) -> bool: ...
+
+    @property
+    def lost_reason(self) -> str: ...
+
+    def send(self, topic: str, message: object) -> None: ...
+
+    def take_received(self) -> list[tuple[str, object, float]]:
+        """(topic, message, monotonic receive time [s]) since the last call."""
+        ...
+
+
+class _Bench:
+    """The world a hardware run happens in: no map, no lights we control."""
+
+    id = "lab_bench"
+    bounds = NO_BOUNDS
+    lights = ()
+
+
+class HardwareRobot:
+    """Duck-types `server.sim.Simulation` for a Run (see the module docstring)."""
+
+    is_hardware = True
+
+    def __init__(
+        self,
+        robot_id: str,
+        link: RobotLink,
+        limits: MotionLimits,
+        watchdog_s: float = DEFAULT_WATCHDOG_S,
+        clock=time.monotonic,
+    ) -> None:
+        self.robot = get_robot(robot_id)
+        self.world = _Bench()
+        self.lights = ()
+        self.link = link
+        self.state = RobotState()  # the true pose is unknown on a bench: stays at the origin
+        self.odometry_origin = Pose2D(0.0, 0.0, 0.0)
+        self.limiter = VelocityLimiter(limits)
+        self.watchdog = Watchdog(watchdog_s)
+        self._clock = clock
+        self._started_s: float | None = None
+        self._time_s = 0.0
+        self._latest: dict[str, object] = {}
+        self._velocity_topics = {
+            t.name for t in self.topics if t.direction is Direction.SUBSCRIBE
+            and t.type_name == "geometry_msgs/Twist"
+        }  # fmt: skip
+        self._zero_sent = False
+        self.commands_sent = 0
+
+    # ------------------------------------------------------------------ what a Run reads
+    @property
+    def topics(self):
+        return self.robot.topics()
+
+    @property
+    def time_s(self) -> float:
+        return self._time_s
+
+    def next_publication_s(self) -> float:
+        return self._time_s + POLL_S
+
+    def reset(self, seed: int | None = None) -> list[Published]:
+        self._started_s = self._clock()
+        self.watchdog = Watchdog(self.watchdog.timeout_s)
+        return []
+
+    def drain_events(self) -> list:
+        return []
+
+    def read(self, topic: str) -> object | None:
+        return self._latest.get(topic)
+
+    # ------------------------------------------------------------------ commands
+    def apply(self, topic: str, message: object) -> None:
+        if not self.link.connected:
+            raise RobotLost(self.link.lost_reason or "robot disconnected")
+        if topic in self._velocity_topics:
+            now = self._clock()
+            wanted = Velocity(message.linear.x, message.angular.z)
+            sent = self.limiter.apply(wanted, now)
+            self.watchdog.feed(now)
+            message = Twist(
+                linear=Vector3(x=sent.linear_m_s), angular=Vector3(z=sent.angular_rad_s)
+            )
+            self._zero_sent = sent == Velocity()
+        self.link.send(topic, message)
+        self.commands_sent += 1
+
+    def press_button(self, pressed: bool) -> None:
+        raise SimulationError("a real robot's button is pressed by a hand on the bench")
+
+    def move_light(self, name: str, x: float, y: float) -> None:
+        raise SimulationError("the lights of the lab bench are not ours to move")
+
+    # ------------------------------------------------------------------ time
+    def step(self, dt_s: float) -> list[Published]:
+        """Advance the run's clock by `dt_s`; return what the robot sent meanwhile."""
+        if not self.link.connected:
+            raise RobotLost(self.link.lost_reason or "robot disconnected")
+        self._time_s += dt_s
+        started = self._started_s if self._started_s is not None else self._clock()
+        published = []
+        for topic, message, received_s in self.link.take_received():
+            time_s = min(self._time_s, max(0.0, received_s - started))
+            self._latest[topic] = message
+            published.append(Published(topic, time_s, message))
+        now = self._clock()
+        if self.watchdog.expired(now) and not self._zero_sent:
+            self._send_zero()
+        return published
+
+    def stop(self) -> None:
+        """Zero velocity and LEDs off: every end of a run (the link may already be gone)."""
+        if not self.link.connected:
+            return
+        self._send_zero()
+        if LEDS_TOPIC in self.robot.commands:
+            msg_type = self.robot.commands[LEDS_TOPIC][0]
+            self.link.send(LEDS_TOPIC, msg_type(data=[0, 0, 0]))
+
+    def _send_zero(self) -> None:
+        for topic in self._velocity_topics:
+            self.link.send(topic, Twist())
+        self.limiter.sent = Velocity()
+        self._zero_sent = True

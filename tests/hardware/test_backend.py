@@ -1,0 +1,134 @@
+"""A Run on a (test double of a) real robot: the simulated robot's topics, the safety layer
+between the node and the wire, the watchdog, zero at every end, and a lost link ending the run.
+The double is a link object as the protocol adapters present one; the wire itself is tested
+with the firmware emulator (test_rosserial*) and the Create emulator (test_create*)."""
+
+from __future__ import annotations
+
+import threading
+import time
+
+import pytest
+
+from sandbox.msgs.std_msgs import Int32
+from sandbox.protocol import Clock
+from server.hardware.backend import HardwareRobot
+from server.hardware.safety import MotionLimits
+from server.runs.run import Run
+from server.runs.spec import NodeSpec, RunSpec, RunSpecError
+from server.runs.state import RunState
+
+LIMITS = MotionLimits(0.2, 2.0, 1.0, 8.0)
+DRIVER = """\
+RATE_HZ = 20
+SUBSCRIBE = ["Distance"]
+
+
+def step(obs):
+    if obs.Distance is None:
+        return None
+    print("saw", obs.Distance.data)
+    return {"Control": (5.0, 0.0)}  # far too fast: the limiter must clamp it
+"""
+
+
+class FakeCrowBot:
+    """A connected CrowBot as the rosserial session would present it: publishes Distance at
+    20 Hz from a thread, records what it is sent."""
+
+    def __init__(self) -> None:
+        self.connected = True
+        self.lost_reason = ""
+        self.sent: list[tuple[float, str, object]] = []
+        self._received: list[tuple[str, object, float]] = []
+        self._lock = threading.Lock()
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._publish, daemon=True)
+        self._thread.start()
+
+    def _publish(self) -> None:
+        while not self._stop.wait(0.05):
+            with self._lock:
+                self._received.append(("Distance", Int32(data=42), time.monotonic()))
+
+    def send(self, topic: str, message: object) -> None:
+        self.sent.append((time.monotonic(), topic, message))
+
+    def take_received(self):
+        with self._lock:
+            taken, self._received = self._received, []
+        return taken
+
+    def close(self) -> None:
+        self._stop.set()
+
+
+@pytest.fixture
+def robot():
+    link = FakeCrowBot()
+    yield link
+    link.close()
+
+
+def spec(code: str, duration_s: float = 1.5, clock: Clock = Clock.REALTIME) -> RunSpec:
+    return RunSpec(
+        robot="crowbot", world="wall_approach",
+        nodes=(NodeSpec("driver", code, "driver.py"),), clock=clock, duration_s=duration_s,
+    )  # fmt: skip
+
+
+def controls(link: FakeCrowBot) -> list[tuple[float, float]]:
+    return [(m.linear.x, m.angular.z) for _, topic, m in link.sent if topic == "Control"]
+
+
+def test_a_node_drives_the_robot_through_the_limits_and_it_stops_at_the_end(
+    tmp_path, launcher, robot
+):
+    backend = HardwareRobot("crowbot", robot, LIMITS)
+    result = Run(spec(DRIVER), launcher, tmp_path / "run", backend=backend).execute()
+    assert result.state is RunState.FINISHED, result.reason
+    sent = controls(robot)
+    assert len(sent) > 10
+    assert max(linear for linear, _ in sent) == pytest.approx(0.2)  # clamped to the limit
+    assert sent[0][0] < 0.2  # ramped up from rest
+    assert sent[-1] == (0.0, 0.0)  # zero at the end
+    leds = [m for _, topic, m in robot.sent if topic == "Leds"]
+    assert leds and list(leds[-1].data) == [0, 0, 0]
+    assert result.nodes["driver"]["wakes"] > 10
+    assert any(
+        "saw 42" in line for line in (tmp_path / "run/logs/driver.log").read_text().split("\n")
+    )
+
+
+def test_the_watchdog_stops_the_robot_when_the_node_goes_quiet(tmp_path, launcher, robot):
+    quiet = DRIVER.replace('    return {"Control": (5.0, 0.0)}', (
+        '    if obs.time < 0.3:\n        return {"Control": (0.1, 0.0)}\n    return None'
+    ))  # fmt: skip
+    backend = HardwareRobot("crowbot", robot, LIMITS, watchdog_s=0.5)
+    Run(spec(quiet, duration_s=2.0), launcher, tmp_path / "run", backend=backend).execute()
+    assert backend.watchdog.trips == 1
+    times = [t for t, topic, m in robot.sent if topic == "Control" and m.linear.x == 0.0]
+    moving = [t for t, topic, m in robot.sent if topic == "Control" and m.linear.x > 0.0]
+    stop_after_s = min(t for t in times if t > moving[-1]) - moving[-1]
+    assert 0.45 <= stop_after_s <= 0.7  # 500 ms after the last command, not at the end
+
+
+def test_a_lost_connection_ends_the_run_with_that_reason(tmp_path, launcher, robot):
+    backend = HardwareRobot("crowbot", robot, LIMITS)
+    run = Run(spec(DRIVER, duration_s=10.0), launcher, tmp_path / "run", backend=backend)
+
+    def unplug() -> None:
+        robot.lost_reason = "robot disconnected"
+        robot.connected = False
+
+    threading.Timer(0.8, unplug).start()
+    result = run.execute()
+    assert result.state is RunState.FAILED
+    assert result.reason == "failed: robot disconnected"
+    assert result.duration_s < 3
+
+
+def test_a_real_robot_needs_the_realtime_clock(tmp_path, launcher, robot):
+    with pytest.raises(RunSpecError, match="realtime"):
+        Run(spec(DRIVER, clock=Clock.LOCKSTEP), launcher, tmp_path / "run",
+            backend=HardwareRobot("crowbot", robot, LIMITS))  # fmt: skip
