@@ -22,6 +22,7 @@ from server.api.routes import (
     admin,
     admin_courses,
     admin_exercises,
+    admin_robots,
     admin_runs,
     catalog,
     live,
@@ -115,7 +116,7 @@ def create_app(settings: Settings | None = None, launcher: Launcher | None = Non
         return await call_next(request)
 
     for module in (session, catalog, workspaces, runs, live, admin, admin_runs, admin_courses,
-                   admin_exercises, viz):  # fmt: skip
+                   admin_exercises, admin_robots, viz):  # fmt: skip
         app.include_router(module.router)
 
     def page(name: str):

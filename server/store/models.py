@@ -141,3 +141,23 @@ class RunRecord(Base):
     checks: Mapped[list] = mapped_column(JSON, default=list)  # exercise check results
     score: Mapped[float | None] = mapped_column(Float, nullable=True)  # 0..1, exercises only
     run_dir: Mapped[str] = mapped_column(Text)
+
+
+class RobotEntry(Base):
+    """A real robot on the lab bench, as the instructor registers it: which kind (a simulated
+    robot id whose topics it has), how it connects, and the limits the safety layer applies."""
+
+    __tablename__ = "robots"
+
+    id: Mapped[str] = mapped_column(String(ID_LENGTH), primary_key=True)
+    name: Mapped[str] = mapped_column(String(64), unique=True)
+    kind: Mapped[str] = mapped_column(String(32))  # "crowbot", "turtlebot"
+    transport: Mapped[str] = mapped_column(String(16))  # "rosserial" | "create_oi"
+    # rosserial: the robot's IP address (a connection from it is this robot);
+    # create_oi: the serial port (/dev/ttyUSB0) and its baud rate.
+    address: Mapped[str] = mapped_column(String(255))
+    baud: Mapped[int | None] = mapped_column(Integer, nullable=True)
+    limits: Mapped[dict] = mapped_column(JSON)  # MotionLimits fields
+    watchdog_s: Mapped[float] = mapped_column(Float)
+    in_service: Mapped[bool] = mapped_column(Boolean, default=True)
+    created_at: Mapped[float] = mapped_column(Float)
