@@ -48,19 +48,3 @@ export async function apiText(path, { signal } = {}) {
   if (!response.ok) throw new ApiError(response.status, await detailOf(response));
   return response.text();
 }
-
-/** Whether `url` answers 2xx, without downloading its body: a GET aborted once the headers
- * are in (not HEAD: FastAPI answers HEAD on a GET route with 405, which browsers log as an
- * error). Resolves {ok, detail}: the server's sentence when it is not there. */
-export async function probe(url) {
-  const controller = new AbortController();
-  try {
-    const response = await fetch(url, { credentials: "same-origin", signal: controller.signal });
-    if (response.ok) return { ok: true, detail: "" };
-    return { ok: false, detail: await detailOf(response) };
-  } catch {
-    return { ok: false, detail: "the server does not answer" };
-  } finally {
-    controller.abort();
-  }
-}

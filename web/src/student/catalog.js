@@ -1,6 +1,8 @@
 // The exercise picker (or a robot in a world, for free play) and the exercise's text: what to
 // do, the checks a run is graded on, and the robot's topics. The choice is kept in the address
-// (#exercise_id or #free/robot/world) and in localStorage, so a reload comes back to it.
+// (#exercise_id or #free/robot/world) and in localStorage, so a reload comes back to it. A run
+// opened by its id (/?run=ID, app.watching) chooses its own exercise or robot and world; any
+// other choice leaves it (and drops ?run= from the address).
 
 import { byId, fill, h } from "../common/dom.js";
 import { app, emit } from "./state.js";
@@ -11,7 +13,8 @@ const exerciseSelect = byId("exercise-select");
 const robotSelect = byId("robot-select");
 const worldSelect = byId("world-select");
 
-export function initCatalog() {
+/** `initial`: the target of a run opened by its id, else the address's or the saved one. */
+export function initCatalog(initial = null) {
   const exercises = [...app.exercises.values()];
   fill(
     exerciseSelect,
@@ -33,8 +36,13 @@ export function initCatalog() {
   details.open = localStorage.getItem("robodojo.textOpen") !== "false";
   details.addEventListener("toggle", () => localStorage.setItem("robodojo.textOpen", String(details.open)));
   byId("picker").hidden = false;
-  const saved = parseHash(location.hash) || readSaved() || { exercise: exercises[0]?.id };
-  choose(saved);
+  const saved = initial || parseHash(location.hash) || readSaved() || { exercise: exercises[0]?.id };
+  choose(saved, { keepWatching: true });
+}
+
+/** Back from a run opened by its id to the student's own code of the same target. */
+export function leaveWatch() {
+  if (app.watching) choose(targetFromControls());
 }
 
 function workspaceKey(target) {
@@ -81,19 +89,30 @@ function resolve(wanted) {
   return { workspace: robot, exercise: null, robot, world };
 }
 
-function choose(wanted) {
+function choose(wanted, { keepWatching = false } = {}) {
+  const wasWatching = Boolean(app.watching);
+  if (wasWatching && !keepWatching) {
+    app.watching = null;
+    emit("watch-ended");
+  }
   const target = resolve(wanted);
   exerciseSelect.value = target.exercise ? target.exercise.id : FREE;
   byId("free-play").hidden = Boolean(target.exercise);
   robotSelect.value = target.robot;
   fillWorlds(target.robot, target.world);
   const hash = target.exercise ? `#${target.exercise.id}` : `#free/${target.robot}/${target.world}`;
-  if (location.hash !== hash) history.replaceState(null, "", hash);
-  localStorage.setItem(
-    STORE_KEY,
-    JSON.stringify(target.exercise ? { exercise: target.exercise.id } : { robot: target.robot, world: target.world }),
-  );
-  const changedWorkspace = !app.target || app.target.workspace !== target.workspace;
+  const query = new URLSearchParams(location.search);
+  if (!app.watching) query.delete("run");
+  const search = query.toString();
+  const address = `${location.pathname}${search ? `?${search}` : ""}${hash}`;
+  if (address !== `${location.pathname}${location.search}${location.hash}`) history.replaceState(null, "", address);
+  if (!app.watching) {
+    localStorage.setItem(
+      STORE_KEY,
+      JSON.stringify(target.exercise ? { exercise: target.exercise.id } : { robot: target.robot, world: target.world }),
+    );
+  }
+  const changedWorkspace = !app.target || app.target.workspace !== target.workspace || wasWatching !== Boolean(app.watching);
   app.target = target;
   showText(target);
   emit("target", { target, changedWorkspace });

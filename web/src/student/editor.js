@@ -1,6 +1,9 @@
 // The code editor: CodeMirror 6 with Python, a tab per node file of the workspace, each with its
 // own undo history; edits are saved to the workspace a moment after typing stops (each save is
-// a version on the server). Ctrl/Cmd+S saves now, Ctrl/Cmd+Enter runs.
+// a version on the server). Ctrl/Cmd+S saves now, Ctrl/Cmd+Enter runs. "+ Node" adds a file; a
+// file the student added (not the exercise's starter) can be deleted with its versions (the
+// tab's x, or Delete on the tab). A run opened by its id (app.watching) shows that run's code
+// read-only instead of a workspace.
 
 import { closeBrackets, closeBracketsKeymap } from "@codemirror/autocomplete";
 import { defaultKeymap, history, historyKeymap, indentWithTab } from "@codemirror/commands";
@@ -34,8 +37,12 @@ const NODE_NAME = /^[A-Za-z][A-Za-z0-9_]{0,39}$/;
 
 const tabsElement = byId("file-tabs");
 const statusElement = byId("save-status");
+const addButton = byId("add-node");
+const versionsButton = byId("versions-button");
 let view = null;
-let workspace = null; // the workspace the files below belong to
+let workspace = null; // the workspace the files below belong to (null: a run's code, read-only)
+let readOnly = false;
+let confirmDialog = null;
 /** filename -> {filename, state, savedCode, version, savedAt, saving, error, autosave} */
 const files = new Map();
 let current = null;
@@ -54,11 +61,18 @@ export function pythonExtensions({ readOnly = false, label = "Python code" } = {
     highlightSelectionMatches(),
     python(),
     EditorState.readOnly.of(readOnly),
-    EditorView.contentAttributes.of({ "aria-label": label }),
+    EditorView.contentAttributes.of(readOnly ? { "aria-label": label, "aria-readonly": "true" } : { "aria-label": label }),
   ];
 }
 
-function fileExtensions(filename) {
+function fileExtensions(filename, { readOnly: locked = false } = {}) {
+  if (locked) {
+    return [
+      pythonExtensions({ readOnly: true, label: `Code of ${filename} in the run on show (read only)` }),
+      search({ top: true }),
+      keymap.of([...defaultKeymap, ...searchKeymap]),
+    ];
+  }
   return [
     pythonExtensions({ label: `Code of ${filename} (Escape then Tab leaves the editor)` }),
     history(),
@@ -87,9 +101,18 @@ export function initEditor({ run }) {
     parent: byId("editor"),
     state: EditorState.create({ doc: "# loading…", extensions: pythonExtensions({ readOnly: true }) }),
   });
-  on("target", ({ changedWorkspace }) => changedWorkspace && load(app.target.workspace));
+  on("target", ({ changedWorkspace }) => {
+    if (app.watching) showRunCode(app.watching);
+    else if (changedWorkspace || readOnly) load(app.target.workspace);
+  });
   on("goto-line", ({ node, line }) => gotoLine(node, line));
   tabsElement.addEventListener("keydown", tabKeys);
+  tabsElement.addEventListener("click", (event) => {
+    const cross = event.target.closest(".tab-delete");
+    if (!cross) return;
+    event.stopPropagation();
+    confirmDelete(cross.dataset.file);
+  });
   initAddNode();
   window.addEventListener("beforeunload", () => {
     for (const file of files.values()) if (isDirty(file)) save(file, { keepalive: true });
@@ -116,6 +139,7 @@ function code(file) {
 async function load(name) {
   await flushAll();
   workspace = name;
+  setReadOnly(false);
   files.clear();
   current = null;
   fill(tabsElement);
@@ -127,26 +151,46 @@ async function load(name) {
     setStatus(`Could not load the code: ${error.message}`, true);
     return;
   }
-  if (workspace !== name) return; // another workspace was chosen meanwhile
-  const loaded = merged(listing.files);
+  if (workspace !== name || app.watching) return; // another workspace was chosen meanwhile
+  const loaded = ordered(listing.files);
   for (const entry of loaded) addFile(entry.filename, entry.code, entry.version, entry.saved_at);
   show(loaded[0].filename);
 }
 
-/** The saved files, with the starter files not saved yet (the server lists only saved files
- * once any is saved), in the starter's order; a template for an empty free-play workspace. */
-function merged(saved) {
-  const starter = (app.target?.exercise?.starter || []).map((s) => ({ filename: fileOf(s.name), version: 0, code: s.code }));
-  const byName = new Map(saved.map((f) => [f.filename, f]));
-  const files = starter.map((s) => byName.get(s.filename) || s);
-  for (const file of saved) if (!starter.some((s) => s.filename === file.filename)) files.push(file);
+/** The workspace's files (the server lists the starter files not saved yet as version 0) with
+ * the starter's files first, in the exercise's order; a template for an empty free-play one. */
+function ordered(listed) {
+  const starter = (app.target?.exercise?.starter || []).map((s) => fileOf(s.name));
+  const rank = (file) => (starter.includes(file.filename) ? starter.indexOf(file.filename) : starter.length);
+  const files = listed.map((file, index) => ({ ...file, index })).sort((a, b) => rank(a) - rank(b) || a.index - b.index);
   return files.length ? files : [{ filename: "controller.py", version: 0, code: template() }];
 }
 
-function addFile(filename, text, version, savedAt) {
+/** The code of a run (opened by its id), a read-only tab per node. */
+async function showRunCode(run) {
+  await flushAll();
+  if (app.watching !== run) return;
+  workspace = null;
+  setReadOnly(true);
+  files.clear();
+  current = null;
+  const code = run.code?.length ? run.code : [{ name: "no_code", code: "# This run's code is not available." }];
+  for (const node of code) addFile(fileOf(node.name), node.code, 0, null, { readOnly: true });
+  show(fileOf(code[0].name));
+}
+
+function setReadOnly(locked) {
+  readOnly = locked;
+  addButton.hidden = locked;
+  byId("add-node-form").hidden = true;
+  addButton.setAttribute("aria-expanded", "false");
+  versionsButton.disabled = locked;
+}
+
+function addFile(filename, text, version, savedAt, { readOnly: locked = false } = {}) {
   const file = {
     filename,
-    state: EditorState.create({ doc: text, extensions: fileExtensions(filename) }),
+    state: EditorState.create({ doc: text, extensions: fileExtensions(filename, { readOnly: locked }) }),
     savedCode: version > 0 ? text : null, // starter code is not saved until it is edited
     version,
     savedAt,
@@ -178,25 +222,38 @@ def step(obs):
 `;
 }
 
+/** A file the student added (not one of the exercise's starter files), when another remains. */
+function deletable(filename) {
+  if (readOnly || files.size < 2) return false;
+  return !(app.target?.exercise?.starter || []).some((s) => fileOf(s.name) === filename);
+}
+
 function renderTabs() {
   fill(
     tabsElement,
     [...files.values()].map((file) => {
       const dirty = isDirty(file);
+      const canDelete = deletable(file.filename);
       return h(
         "button",
         {
           type: "button",
           role: "tab",
-          class: "file-tab",
+          class: `file-tab${canDelete ? " can-delete" : ""}`,
           "aria-selected": String(file.filename === current),
           "aria-controls": "editor",
+          "aria-keyshortcuts": canDelete ? "Delete" : null,
+          "aria-describedby": canDelete ? "file-delete-hint" : null,
           tabindex: file.filename === current ? 0 : -1,
           dataset: { testid: "editor-tab", file: file.filename },
           onclick: () => show(file.filename),
         },
         file.filename,
         dirty ? h("span", { class: "dirty", title: "unsaved changes", "aria-label": "(unsaved)" }, " •") : null,
+        // A mouse's way to delete; the keyboard's is Delete on the tab (aria-keyshortcuts).
+        canDelete
+          ? h("span", { class: "tab-delete", "aria-hidden": "true", title: `Delete ${file.filename}`, dataset: { testid: "file-delete", file: file.filename } })
+          : null,
       );
     }),
   );
@@ -206,6 +263,11 @@ function tabKeys(event) {
   const buttons = [...tabsElement.querySelectorAll('[role="tab"]')];
   const index = buttons.indexOf(document.activeElement);
   if (index < 0) return;
+  if (event.key === "Delete" && deletable(buttons[index].dataset.file)) {
+    event.preventDefault();
+    confirmDelete(buttons[index].dataset.file);
+    return;
+  }
   const step = { ArrowRight: 1, ArrowLeft: -1 }[event.key];
   if (!step) return;
   event.preventDefault();
@@ -238,6 +300,7 @@ const renderTabsSoon = debounce(renderTabs, 150);
 
 async function save(file, { keepalive = false } = {}) {
   file.autosave.cancel();
+  if (file.deleted || readOnly) return;
   const text = code(file);
   if (text === file.savedCode) return;
   if (file.saving) {
@@ -285,6 +348,7 @@ export async function flushAll() {
 function showStatus() {
   const file = files.get(current);
   if (!file) return setStatus("");
+  if (readOnly) return setStatus("Read only: the code this run was started with");
   if (file.error) return setStatus(`Not saved: ${file.error}`, true);
   if (file.saving) return setStatus("Saving…");
   if (file.savedCode === null && !file.edited) return setStatus("Starter code");
@@ -295,6 +359,72 @@ function showStatus() {
 function setStatus(text, error = false) {
   statusElement.textContent = text;
   statusElement.classList.toggle("error", error);
+}
+
+/** Ask, then delete a file the student added: its versions on the server, its tab here. */
+function confirmDelete(filename) {
+  const file = files.get(filename);
+  if (!file || !deletable(filename)) return;
+  if (!confirmDialog) {
+    confirmDialog = h(
+      "dialog",
+      { class: "confirm", "aria-labelledby": "delete-title", "aria-describedby": "delete-text", dataset: { testid: "file-delete-dialog" } },
+      h("h2", { id: "delete-title" }),
+      h("p", { id: "delete-text" }),
+      h(
+        "form",
+        { method: "dialog", class: "dialog-buttons" },
+        h("button", { type: "submit", value: "cancel", class: "small", autofocus: true, dataset: { testid: "file-delete-cancel" } }, "Cancel"),
+        h("button", { type: "submit", value: "delete", class: "small danger", dataset: { testid: "file-delete-confirm" } }, "Delete"),
+      ),
+    );
+    document.body.append(confirmDialog);
+  }
+  const count = Math.max(file.version, file.saving ? 1 : 0);
+  confirmDialog.querySelector("#delete-title").textContent = `Delete ${filename}?`;
+  confirmDialog.querySelector("#delete-text").textContent = count
+    ? `${filename} and its ${count} saved version${count === 1 ? "" : "s"} are deleted from your workspace. This cannot be undone.`
+    : `${filename} has not been saved yet: its tab is closed.`;
+  confirmDialog.returnValue = "";
+  confirmDialog.addEventListener(
+    "close",
+    () => {
+      if (confirmDialog.returnValue === "delete") deleteFile(filename);
+      else tabsElement.querySelector(`[data-file="${CSS.escape(filename)}"]`)?.focus();
+    },
+    { once: true },
+  );
+  confirmDialog.showModal();
+}
+
+async function deleteFile(filename) {
+  const file = files.get(filename);
+  if (!file) return;
+  const name = workspace;
+  file.deleted = true; // no more saves: a late one would bring it back
+  file.autosave.cancel();
+  if (file.saving) await file.saving;
+  if (file.version > 0) {
+    try {
+      await api(`/api/workspaces/${encodeURIComponent(name)}/files/${encodeURIComponent(filename)}`, { method: "DELETE" });
+    } catch (error) {
+      if (error.status !== 404) {
+        file.deleted = false;
+        setStatus(`Not deleted: ${error.message}`, true);
+        return;
+      }
+    }
+  }
+  if (workspace !== name || files.get(filename) !== file) return;
+  const names = [...files.keys()];
+  const index = names.indexOf(filename);
+  files.delete(filename);
+  if (current === filename) {
+    current = null;
+    show(names[index + 1] || names[index - 1]);
+  } else renderTabs();
+  setStatus(`Deleted ${filename}`);
+  tabsElement.querySelector('[aria-selected="true"]')?.focus();
 }
 
 /** The file on show and its workspace (for the versions dialog). */
@@ -338,7 +468,7 @@ function gotoLine(node, lineNumber) {
 }
 
 function initAddNode() {
-  const button = byId("add-node");
+  const button = addButton;
   const form = byId("add-node-form");
   const input = byId("add-node-name");
   button.addEventListener("click", () => {

@@ -55,10 +55,12 @@ async function refresh() {
   const run = app.run;
   if (!run) return;
   try {
-    const graph = await api(`/api/runs/${run.id}/graph`);
+    const graph = await api(run.links?.graph || `/api/runs/${run.id}/graph`);
     if (app.run?.id !== run.id) return;
     last = graph;
     draw(graph);
+    app.graphNodes.set(run.id, graph.nodes);
+    emit("run-graph", { run, graph });
     for (const topic of graph.topics) emit("run-topic", { topic: topic.name, msg_type: topic.type });
   } catch (error) {
     if (app.run?.id === run.id) status.textContent = `No graph: ${error.message}`;

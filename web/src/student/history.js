@@ -4,6 +4,7 @@
 
 import { api } from "../common/api.js";
 import { byId, fill, h, when } from "../common/dom.js";
+import { leaveWatch } from "./catalog.js";
 import { checkChip, showRun } from "./runner.js";
 import { app, END_STATES, on } from "./state.js";
 
@@ -22,7 +23,8 @@ export function initHistory() {
 
 async function load({ openNewest = false } = {}) {
   const target = app.target;
-  const query = target.exercise ? `exercise=${encodeURIComponent(target.exercise.id)}&limit=${LIMIT}` : `limit=${LIMIT * 2}`;
+  // Free play: the robot's runs (the server filters by robot; its exercise runs are left out).
+  const query = target.exercise ? `exercise=${encodeURIComponent(target.exercise.id)}&limit=${LIMIT}` : `robot=${encodeURIComponent(target.robot)}&limit=${LIMIT * 2}`;
   let answer;
   try {
     answer = await api(`/api/runs?${query}`);
@@ -31,11 +33,18 @@ async function load({ openNewest = false } = {}) {
     return;
   }
   if (app.target !== target) return;
-  runs = target.exercise ? answer.runs : answer.runs.filter((r) => !r.exercise && r.robot === target.robot).slice(0, LIMIT);
-  status.textContent = runs.length ? "" : "No runs yet.";
+  runs = target.exercise ? answer.runs : answer.runs.filter((r) => !r.exercise).slice(0, LIMIT);
+  status.textContent = app.watching
+    ? "Your own runs; opening one leaves the run opened by its id."
+    : runs.length
+      ? ""
+      : "No runs yet.";
   render();
+  if (!openNewest || app.watching) return; // a run opened by its id stays on show
   const showing = app.run && runs.some((r) => r.id === app.run.id);
-  if (openNewest && runs.length && !showing) showRun(runs[0]);
+  // Free play opens the newest run in the world chosen (the robot's runs span its worlds).
+  const newest = runs.find((r) => target.exercise || r.world === target.world);
+  if (newest && !showing) showRun(newest);
 }
 
 function render() {
@@ -57,7 +66,7 @@ function render() {
           checks.length ? h("span", { class: `score ${passed === checks.length ? "pass" : "fail"}` }, `${passed}/${checks.length}`) : null,
           h(
             "button",
-            { type: "button", class: "small", disabled: current, onclick: () => showRun(run), dataset: { testid: "history-open" }, "aria-label": `Open the run of ${when(run.created_at)}` },
+            { type: "button", class: "small", disabled: current, onclick: () => open(run), dataset: { testid: "history-open" }, "aria-label": `Open the run of ${when(run.created_at)}` },
             current ? "On show" : END_STATES.has(run.state) ? "Open" : "Follow",
           ),
         ),
@@ -66,6 +75,12 @@ function render() {
       );
     }),
   );
+}
+
+/** Put a run on show; from a run opened by its id, back to the student's own code first. */
+function open(run) {
+  leaveWatch();
+  showRun(run);
 }
 
 function target(run) {

@@ -1,4 +1,5 @@
-// Run controls and the run on show: start a run in simulation (clock, duration, seed), stop,
+// Run controls and the run on show: start a run in simulation (clock, duration, seed; in free
+// play optionally with the teleop node, "Drive with arrow keys"), stop,
 // pause/resume (lockstep only), the progress of simulated time, the state and why it ended,
 // and the checks. A live run is followed over its websocket and its record polled for the
 // figures the websocket does not carry (node periods, time).
@@ -16,6 +17,9 @@ const form = byId("run-form");
 const clockInput = byId("run-clock");
 const durationInput = byId("run-duration");
 const seedInput = byId("run-seed");
+const teleopOption = byId("teleop-option");
+const teleopInput = byId("run-teleop");
+const TELEOP_KEY = "robodojo.teleop";
 const runButton = byId("run-button");
 const pauseButton = byId("pause-button");
 const stopButton = byId("stop-button");
@@ -41,10 +45,13 @@ export function initRunner() {
   byId("real-robot-button").addEventListener("click", () => {
     say("The lab's real robots are not connected yet: run in simulation for now.");
   });
+  teleopInput.checked = localStorage.getItem(TELEOP_KEY) === "true";
+  teleopInput.addEventListener("change", () => localStorage.setItem(TELEOP_KEY, String(teleopInput.checked)));
   on("target", ({ target }) => {
     clockInput.value = target.exercise?.clock || "lockstep";
     durationInput.value = target.exercise?.duration_s ?? 30;
     seedInput.value = "";
+    teleopOption.hidden = Boolean(target.exercise) || Boolean(app.watching); // exercises say
     forget();
   });
   controls();
@@ -53,6 +60,10 @@ export function initRunner() {
 /** Start a run of the editor's nodes for the target. */
 export async function start() {
   if (starting || (app.live && !END_STATES.has(state))) return;
+  if (app.watching) {
+    say("This is a run opened by its id, with its code read only: go back to your code to run.");
+    return;
+  }
   if (!form.reportValidity()) return;
   starting = true;
   controls();
@@ -63,10 +74,13 @@ export async function start() {
   body.clock = clockInput.value;
   body.duration = Number(durationInput.value);
   if (seedInput.value !== "") body.seed = Number(seedInput.value);
+  if (!target.exercise && teleopInput.checked) body.teleop = true;
   flushAll(); // the run gets the code in the request; the workspace keeps it too
   try {
     const run = await api("/api/runs", { method: "POST", body });
+    if (body.teleop) app.teleopRuns.add(run.id);
     showRun(run);
+    if (body.teleop) emit("drive"); // the World tab, its pad focused: the arrow keys drive
   } catch (error) {
     say(error.message); // the server's sentence, verbatim
   } finally {
@@ -231,7 +245,7 @@ function progressOf(run) {
 
 function controls() {
   const active = Boolean(app.live) && !END_STATES.has(state);
-  runButton.disabled = starting || active;
+  runButton.disabled = starting || active || Boolean(app.watching);
   runButton.textContent = starting ? "Starting…" : "▶ Run in simulation";
   stopButton.disabled = !active;
   const lockstep = app.run?.clock === "lockstep";

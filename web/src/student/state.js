@@ -12,6 +12,9 @@
 //   run-topic  {topic, msg_type}   a topic of the live run seen for the first time
 //   run-ended  {run}               the run on show has ended and its record (checks) is stored
 //   goto-line  {node, line}        show this line of this node's file in the editor
+//   run-graph  {run, graph}        the node/topic graph of the run on show (its built-in nodes)
+//   drive      {}                  a run to drive with the arrow keys started: show the pad
+//   watch-ended {}                 the run opened by its id is left for the student's own code
 
 export const app = {
   me: null,
@@ -23,6 +26,13 @@ export const app = {
   /** The run on show (its latest record) and whether it is live. */
   run: null,
   live: null, // LiveRun while the run on show is going
+  /** A run opened by its id (/?run=ID, e.g. an instructor watching a student's run): the
+   * editor shows that run's code read-only instead of a workspace. */
+  watching: null,
+  /** Ids of runs this page started with the teleop node (free play, "Drive with arrow keys"). */
+  teleopRuns: new Set(),
+  /** run id -> the nodes its graph lists (student and built-in), once the graph is loaded. */
+  graphNodes: new Map(),
 };
 
 const bus = new EventTarget();
@@ -61,6 +71,15 @@ export function applyWants() {
 /** The robot's topics that the robot publishes (sensors), then the others, as the API lists them. */
 export function robotTopics(robotId) {
   return app.robots.get(robotId)?.topics || [];
+}
+
+/** Whether the arrow keys can drive this run: the page started it with teleop, its exercise
+ * has the teleop node, or its graph lists one. */
+export function runHasTeleop(run) {
+  if (!run) return Boolean(app.target?.exercise?.builtin_nodes?.includes("teleop"));
+  if (app.teleopRuns.has(run.id)) return true;
+  if (app.exercises.get(run.exercise)?.builtin_nodes?.includes("teleop")) return true;
+  return Boolean(app.graphNodes.get(run.id)?.includes("teleop"));
 }
 
 /** A node's file name from its node name, and back. */
