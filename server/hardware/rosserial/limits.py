@@ -20,6 +20,7 @@ class RosserialLimits:
     max_bytes_per_s: int
     max_frames_per_s: int
     max_write_buffer_bytes: int
+    socket_send_buffer_bytes: int
     max_outbox_bytes: int
     max_connections: int
     max_problems: int
@@ -56,6 +57,11 @@ DEFAULT_LIMITS = RosserialLimits(
     # [bytes] unsent data queued for a robot that does not read (half-open link). Past this,
     # commands are dropped and counted: a stale Control is worse than none.
     max_write_buffer_bytes=16 * 1024,
+    # [bytes] the kernel's send buffer per robot (SO_SNDBUF; Linux doubles it). Without it Linux
+    # grows the buffer to megabytes on a fast link, where a stalled robot's commands would queue
+    # for seconds; commands are a few kB/s, so a small buffer costs nothing and stale commands
+    # are dropped (and counted) here instead of delivered late.
+    socket_send_buffer_bytes=16 * 1024,
     # [bytes] frames a session queues between two drains by its connection (the server drains
     # after every call, so this only bounds a caller that forgets).
     max_outbox_bytes=64 * 1024,

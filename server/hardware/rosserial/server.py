@@ -183,6 +183,9 @@ class _Connection(asyncio.BufferedProtocol):
             with contextlib.suppress(OSError):
                 sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
                 sock.setsockopt(socket.SOL_SOCKET, socket.SO_KEEPALIVE, 1)
+                sock.setsockopt(
+                    socket.SOL_SOCKET, socket.SO_SNDBUF, server.limits.socket_send_buffer_bytes
+                )
         session = RosserialSession(clock_ns=server.clock_ns, limits=server.limits)
         robot = RobotConnection(server, f"robot-{next(server._ids)}", (peer[0], peer[1]), session)
         robot._transport = transport
