@@ -15,8 +15,9 @@ as it would /dev/ttyUSB0, and the emulator answers the Open Interface on the mas
   (their encoders stop too) and the bump switches close on the side that touches;
 - a wheel drop (`drop_wheels()`) in Safe mode stops the wheels and falls back to Passive.
 
-Test hooks: `inject(garbage)` writes raw bytes onto the line, `go_silent()` stops every answer,
-`received` lists the commands the robot understood with their data bytes, `pose()` the truth.
+Test hooks: `frames_per_delivery` bunches frames as a USB adapter does, `inject(garbage)`
+writes raw bytes onto the line, `go_silent()` stops every answer, `received` lists the commands
+the robot understood with their data bytes, `pose()` is the truth.
 Time is the wall clock: one physics step per 15 ms tick of time.monotonic.
 """
 
@@ -82,6 +83,7 @@ class CreateEmulator:
         room: Room | None = None,
         start_pose: tuple[float, float, float] = (0.0, 0.0, 0.0),
         encoder_start: tuple[int, int] = (0, 0),
+        frames_per_delivery: int = 1,
     ) -> None:
         self.room = room or Room()
         self.x_m, self.y_m, self.yaw_rad = start_pose
@@ -99,6 +101,10 @@ class CreateEmulator:
         self._silent = False
         self.received: list[tuple[int, bytes]] = []
         self.frames_sent = 0
+        # A USB-serial adapter holds bytes for its latency timer (FTDI: 16 ms) and hands them
+        # over in bunches; frames_per_delivery > 1 writes that many frames at once.
+        self.frames_per_delivery = frames_per_delivery
+        self._held = bytearray()
         self._pending = bytearray()
         self._lock = threading.Lock()
         self._master_fd, self._slave_fd = os.openpty()
@@ -272,8 +278,11 @@ class CreateEmulator:
         self._move(TICK_S)
         if self._streaming:
             frame = oi.encode_stream_frame({i: self._packet_value(i) for i in self._stream_ids})
-            self._send(frame)
+            self._held += frame
             self.frames_sent += 1
+            if self.frames_sent % self.frames_per_delivery == 0:
+                self._send(bytes(self._held))
+                self._held.clear()
 
     def _walls(self) -> tuple[tuple[float, float, float], ...]:
         """(inward normal x, y, offset c) of each wall: inside the room, n . p >= c."""

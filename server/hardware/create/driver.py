@@ -208,6 +208,7 @@ class CreateDriver:
         # Motion since the last odom message, for its twist.
         self._window_distance_m = 0.0
         self._window_yaw_rad = 0.0
+        self._window_steps = 0  # encoder samples in the window, one per 15 ms frame
         self._window_start_s: float | None = None  # monotonic
         self._last_publish_s: float | None = None  # monotonic
 
@@ -457,6 +458,7 @@ class CreateDriver:
             )
             self._window_distance_m += step.distance_m
             self._window_yaw_rad += step.yaw_change_rad
+            self._window_steps += 1
             bits = packets[oi.BUMPS_WHEEL_DROPS]
             bumper = (int(bool(bits & oi.BUMP_LEFT_BIT)), int(bool(bits & oi.BUMP_RIGHT_BIT)))
             bumper_changed |= bumper != self._bumper
@@ -495,12 +497,22 @@ class CreateDriver:
         )
         logger.warning(self._mode_problem)
 
+    def _window_duration_s(self, now_s: float) -> float:
+        """How long the motion in the window took [s]. The robot sends a frame every 15 ms on
+        its own clock, so frames x 15 ms beats the host's receive times, which bunch frames up
+        (a USB adapter or a busy host delivers two or three at once: +-50% speed jitter at
+        20 Hz). Unless frames were lost: then the host's time is the better count."""
+        host_s = now_s - (self._window_start_s if self._window_start_s is not None else now_s)
+        robot_s = self._window_steps * oi.STREAM_PERIOD_S
+        return host_s if host_s > robot_s + 3 * oi.STREAM_PERIOD_S else robot_s
+
     def _odometry_message(self, stamp_s: float, now_s: float) -> object:
-        window_s = now_s - (self._window_start_s if self._window_start_s is not None else now_s)
+        window_s = self._window_duration_s(now_s)
         linear_m_s = self._window_distance_m / window_s if window_s > 0 else 0.0
         angular_rad_s = self._window_yaw_rad / window_s if window_s > 0 else 0.0
         self._window_distance_m = 0.0
         self._window_yaw_rad = 0.0
+        self._window_steps = 0
         self._window_start_s = now_s
         pose = self._odometry.pose
         message = self._odometry_cls()
