@@ -11,13 +11,6 @@ from pathlib import Path
 import httpx
 
 from tests.api.conftest import STEP_CONTROLLER, LabServer, wait_for_end
-from tests.e2e.conftest import (  # noqa: F401  (fixtures, used by name)
-    _close_web_lab_clients,
-    browser,
-    new_page,
-    screenshots,
-    web_lab,
-)
 
 WEB = Path(__file__).resolve().parents[2] / "web"
 MODULES = WEB / "static" / "admin"
@@ -37,8 +30,8 @@ def exported_names(path: Path) -> set[str]:
     return set(EXPORT.findall(path.read_text("utf-8")))
 
 
-def test_console_page_and_modules_are_served(lab: LabServer) -> None:
-    with httpx.Client(base_url=lab.url) as client:
+def test_console_page_and_modules_are_served(web_lab: LabServer) -> None:
+    with httpx.Client(base_url=web_lab.url) as client:
         page = client.get("/admin")
         assert page.status_code == 200
         assert page.headers["content-type"].startswith("text/html")
@@ -73,7 +66,7 @@ def _log_in(page, lab: LabServer, token: str) -> None:
     page.goto(f"{lab.url}/admin")
 
 
-def test_instructor_console_in_chromium(web_lab, new_page, screenshots) -> None:  # noqa: F811
+def test_instructor_console_in_chromium(web_lab, new_page, screenshots) -> None:
     from playwright.sync_api import expect
 
     lab = web_lab

@@ -137,7 +137,7 @@ def test_another_student_cannot_open_the_run_or_its_3d_view(web_lab, new_page, s
         page = new_page()
         page.goto(invite)
         page.goto(f"{web_lab.url}/?run={run_id}")
-        expect(page.get_by_test_id("run-message")).to_contain_text("no such run")
+        expect(page.get_by_test_id("run-not-found")).to_contain_text("no such run")
         shot(page, screenshots, "stranger-run")
         answer = page.goto(f"{web_lab.url}/api/runs/{run_id}/viz/")
         assert answer.status == 404

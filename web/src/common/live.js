@@ -33,7 +33,11 @@ export class LiveRun {
     socket.addEventListener("open", () => {
       this.failures = 0;
       this.onStatus("");
-      for (const [topic, rate] of this.subscriptions) this.command("subscribe", { topic, max_rate_hz: rate });
+      // A run that ends at once closes the socket before it answers: nothing to report then
+      // (a reconnect subscribes again).
+      for (const [topic, rate] of this.subscriptions) {
+        this.command("subscribe", { topic, max_rate_hz: rate }).catch(() => {});
+      }
     });
     socket.addEventListener("message", (event) => this.receive(event.data));
     socket.addEventListener("close", (event) => this.lost(event));
