@@ -146,6 +146,11 @@ class CreateEmulator:
         with self._lock:
             self._silent = False
 
+    def put_down(self) -> None:
+        """Undo drop_wheels(): the wheels touch the floor again (the mode stays Passive)."""
+        with self._lock:
+            self._wheel_drops = 0
+
     def drop_wheels(self) -> None:
         """Lift the robot: both wheel drops close; in Safe mode it stops and goes Passive."""
         with self._lock:
@@ -154,6 +159,9 @@ class CreateEmulator:
                 self._set_mode(oi.OIMode.PASSIVE)
 
     def close(self) -> None:
+        """End the robot and both ends of the pty (a pulled cable, for a driver still open)."""
+        if not self._running:
+            return
         self._running = False
         self._thread.join()
         os.close(self._master_fd)

@@ -358,8 +358,33 @@ def test_leaving_safe_mode_is_reported(emulator, recorder):
         driver.command(twist(0.2))
         time.sleep(0.05)
         assert emulator.left_mm_s == 0  # the robot ignores drive commands in Passive
+        emulator.put_down()
+        driver.rearm()
+        assert wait_for(lambda: driver.oi_mode is oi.OIMode.SAFE)
+        assert driver.problem is None
+        driver.command(twist(0.2))
+        assert wait_for(lambda: emulator.left_mm_s == 200)
     finally:
         driver.close()
+
+
+def test_stop_with_off_sends_stop(emulator, recorder):
+    driver = open_driver(emulator, recorder, stop_with="off")
+    driver.close()
+    assert emulator.received[-1] == (oi.Opcode.STOP, b"")
+    assert wait_for(lambda: emulator.mode is oi.OIMode.OFF)
+
+
+def test_a_pulled_cable_is_reported(emulator, recorder):
+    driver = open_driver(emulator, recorder)
+    emulator.close()
+    assert wait_for(lambda: driver.state is CreateState.SILENT, 2.0)
+    assert driver.problem is not None
+    assert driver.problem.startswith(f"reading the serial port {emulator.port} failed")
+    with pytest.raises(CreatePortError, match="the cable may be unplugged"):
+        driver.command(twist(0.1))
+    driver.close()  # does not hang on the dead port
+    assert driver.state is CreateState.CLOSED
 
 
 # --- cannot connect ------------------------------------------------------------------------------

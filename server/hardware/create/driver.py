@@ -160,6 +160,7 @@ class CreateDriver:
         baud: int = DEFAULT_BAUD,
         *,
         mode: Literal["safe", "full"] = "safe",
+        stop_with: Literal["passive", "off"] = "passive",
         on_message: OnMessage | None = None,
         on_state: OnState | None = None,
         clock: Callable[[], float] = time.time,
@@ -172,11 +173,14 @@ class CreateDriver:
     ) -> None:
         if mode not in ("safe", "full"):
             raise ValueError(f"mode must be 'safe' or 'full', got {mode!r}")
+        if stop_with not in ("passive", "off"):
+            raise ValueError(f"stop_with must be 'passive' or 'off', got {stop_with!r}")
         if publish_rate_hz <= 0.0:
             raise ValueError(f"publish_rate_hz must be > 0, got {publish_rate_hz}")
         self.port = port
         self.baud = int(baud)
         self.mode = mode
+        self.stop_with = stop_with
         self.on_message = on_message
         self.on_state = on_state
         self.clock = clock
@@ -279,14 +283,17 @@ class CreateDriver:
             self._write(oi.encode_opcode(self._mode_opcode()))
             time.sleep(MODE_CHANGE_PAUSE_S)
             self._write(oi.encode_stream(STREAM_PACKETS))
-        except (serial.SerialException, OSError) as exc:
+        except CreatePortError:
             self._abort_open()
-            raise CreatePortError(f"writing to the Create on {self.port} failed: {exc}") from exc
+            raise
         self._reader = threading.Thread(target=self._read_loop, name="create-reader", daemon=True)
         self._reader.start()
         if not self._first_frame.wait(self.connect_timeout_s):
             received = self._bytes_received
+            port_failure = self._problem
             self._abort_open()
+            if port_failure is not None:
+                raise CreatePortError(port_failure)
             if received:
                 detail = (
                     f"{received} bytes came back but no valid sensor frame: is the baud rate "
@@ -307,6 +314,9 @@ class CreateDriver:
 
     def _mode_opcode(self) -> oi.Opcode:
         return oi.Opcode.SAFE if self.mode == "safe" else oi.Opcode.FULL
+
+    def _stop_opcode(self) -> oi.Opcode:
+        return oi.Opcode.START if self.stop_with == "passive" else oi.Opcode.STOP
 
     def _abort_open(self) -> None:
         self._stop_reading.set()
@@ -365,17 +375,19 @@ class CreateDriver:
         self._write(oi.encode_opcode(self._mode_opcode()))
 
     def stop(self) -> None:
-        """Zero velocity, pause the stream, then Start, which drops the robot to Passive: every
-        OI version knows it, and the firmware holds the wheels still in Passive. The driver then
-        takes no more commands. Safe to call twice."""
+        """Zero velocity, pause the stream, then leave user control: by default Start, which
+        drops the robot to Passive (every OI version knows it, and the firmware holds the wheels
+        still in Passive); with stop_with="off", Stop (173), which shuts the OI down (Create 2 /
+        Roomba 600 OI; older firmware ignores it). The driver then takes no more commands.
+        Safe to call twice."""
         if self._state in (CreateState.NEW, CreateState.STOPPED, CreateState.CLOSED):
             return
         try:
             self._drive(0.0, 0.0)
             self._write(oi.encode_pause_resume_stream(resume=False))
-            self._write(oi.encode_opcode(oi.Opcode.START))
-        except (serial.SerialException, OSError) as exc:
-            logger.warning("stopping the Create on %s: %s", self.port, exc)
+            self._write(oi.encode_opcode(self._stop_opcode()))
+        except CreatePortError as exc:
+            logger.warning("stopping the Create: %s", exc)
         self._stop_reading.set()
         if self._reader is not None and self._reader is not threading.current_thread():
             self._reader.join()
@@ -394,8 +406,14 @@ class CreateDriver:
 
     def _write(self, data: bytes) -> None:
         assert self._serial is not None
-        with self._write_lock:
-            self._serial.write(data)
+        try:
+            with self._write_lock:
+                self._serial.write(data)
+        except (serial.SerialException, OSError) as exc:
+            raise CreatePortError(
+                f"writing to the Create on {self.port} failed ({exc}): the cable may be "
+                "unplugged; make a new CreateDriver once it is back"
+            ) from exc
 
     def _read_loop(self) -> None:
         assert self._serial is not None
@@ -404,7 +422,10 @@ class CreateDriver:
             try:
                 chunk = self._serial.read(max(1, self._serial.in_waiting))
             except (serial.SerialException, OSError) as exc:
-                self._on_port_failure(exc)
+                self._on_port_failure(
+                    f"reading the serial port {self.port} failed ({exc}): the cable may be "
+                    "unplugged; odometry is frozen, make a new CreateDriver once it is back"
+                )
                 return
             now_s = time.monotonic()
             if chunk:
@@ -416,11 +437,7 @@ class CreateDriver:
             self._check_silence(now_s - last_frame_s)
             self._check_latch(now_s)
 
-    def _on_port_failure(self, exc: BaseException) -> None:
-        reason = (
-            f"the serial port {self.port} failed ({exc}): the cable may be unplugged; odometry "
-            "is frozen, make a new CreateDriver once it is back"
-        )
+    def _on_port_failure(self, reason: str) -> None:
         logger.error(reason)
         if self._state is CreateState.STREAMING:
             self._transition(CreateState.SILENT, reason)
@@ -446,8 +463,8 @@ class CreateDriver:
             logger.info("no cmd_vel for %.2f s: stopping the wheels", self.command_latch_s)
             try:
                 self._drive(0.0, 0.0)
-            except (serial.SerialException, OSError) as exc:
-                self._on_port_failure(exc)
+            except CreatePortError as exc:
+                self._on_port_failure(str(exc))
 
     def _on_frames(self, frames: list[dict[int, int]], now_s: float) -> None:
         stamp_s = self.clock()
