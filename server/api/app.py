@@ -25,6 +25,7 @@ from server.api.routes import (
     admin_robots,
     admin_runs,
     catalog,
+    hardware,
     live,
     runs,
     session,
@@ -32,6 +33,7 @@ from server.api.routes import (
     workspaces,
 )
 from server.api.settings import Settings
+from server.service.hardware import HardwareHub
 from server.service.runs import RunService
 from server.store import accounts
 from server.store import runs as run_store
@@ -71,7 +73,9 @@ def create_app(settings: Settings | None = None, launcher: Launcher | None = Non
         )
         app.state.settings = settings
         app.state.store = store
-        app.state.runs = RunService(store, settings, run_launcher)
+        app.state.hardware = HardwareHub(store, settings)
+        app.state.hardware.start()
+        app.state.runs = RunService(store, settings, run_launcher, app.state.hardware)
         url = bootstrap(store, settings)
         if url:
             print(f"RoboDojo: log in as the instructor at {url}", flush=True)
@@ -83,7 +87,8 @@ def create_app(settings: Settings | None = None, launcher: Launcher | None = Non
         try:
             yield
         finally:
-            app.state.runs.shutdown()
+            app.state.runs.shutdown()  # robots commanded to zero as their runs end
+            app.state.hardware.stop()
             if own_launcher:
                 run_launcher.close()
             store.close()
@@ -116,7 +121,7 @@ def create_app(settings: Settings | None = None, launcher: Launcher | None = Non
         return await call_next(request)
 
     for module in (session, catalog, workspaces, runs, live, admin, admin_runs, admin_courses,
-                   admin_exercises, admin_robots, viz):  # fmt: skip
+                   admin_exercises, admin_robots, hardware, viz):  # fmt: skip
         app.include_router(module.router)
 
     def page(name: str):

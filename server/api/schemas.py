@@ -32,6 +32,9 @@ class RunCreate(Strict):
     duration: float | None = Field(None, gt=0, le=86400, description="[s] of robot time")
     seed: int | None = Field(None, ge=0, le=2**31 - 1)
     teleop: bool = Field(False, description="drive with the arrow keys (adds the teleop node)")
+    hardware: str | None = Field(
+        None, pattern=r"^[a-z][a-z0-9_\-]{0,63}$", description="run on this robot of the bench"
+    )
 
 
 class RunCommand(Strict):

@@ -17,7 +17,7 @@ from server.api.settings import Settings
 
 def _settings(args: argparse.Namespace) -> Settings:
     overrides = {}
-    for key in ("host", "port", "data", "database_url", "public_url"):
+    for key in ("host", "port", "data", "database_url", "public_url", "rosserial_port"):
         value = getattr(args, key, None)
         if value is not None:
             overrides[key] = value
@@ -91,6 +91,12 @@ def _common(parser: argparse.ArgumentParser) -> None:
 def add_commands(commands) -> None:
     serve = commands.add_parser("serve", help="start the web lab (API, websockets, pages)")
     _common(serve)
+    serve.add_argument(
+        "--rosserial-port",
+        type=int,
+        default=None,
+        help="TCP port real CrowBots connect to (default 11411; 0 any free port; -1 off)",
+    )
     serve.add_argument(
         "--unsafe-no-sandbox",
         action="store_true",

@@ -30,6 +30,13 @@ class Settings(BaseSettings):
     max_files_per_workspace: int = Field(16, ge=1)
     retry_after_s: int = Field(10, ge=1)  # [s] told to a client that hit a run limit
 
+    # Real robots: CrowBots (ros_lib over WiFi) connect to this TCP port; rosserial_python's
+    # 11411 by default; 0 = any free port (tests); -1 = off. All interfaces: robots are on the
+    # lab's network, not this machine (a connection from an unregistered address is refused).
+    rosserial_port: int = Field(11411, ge=-1, le=65535)
+    rosserial_host: str = "0.0.0.0"
+    hardware_gate: bool = True  # a hardware run needs the same code to have passed in simulation
+
     unsafe_no_sandbox: bool = False  # trusted machines only: student code runs unconfined
     sandbox_pool: int = Field(2, ge=0)  # warm sandbox processes kept ready
     shutdown_grace_s: float = Field(10.0, gt=0)  # [s] runs get this long to stop cleanly

@@ -55,6 +55,7 @@ class RunRequest:
     duration_s: float | None
     seed: int | None
     teleop: bool = False  # the teleop built-in: arrow keys from the browser drive the robot
+    hardware: str | None = None  # a robot on the bench (inventory name) instead of simulation
 
 
 @dataclass
@@ -63,6 +64,7 @@ class ActiveRun:
     user_id: str
     telemetry: RunTelemetry
     exercise: ExerciseEntry | None
+    hardware: str | None = None  # the bench robot's name, for a hardware run
     started_wall: float = field(default_factory=time.monotonic)
 
 
@@ -100,7 +102,8 @@ class _Watch:
 
 
 class RunService:
-    def __init__(self, store: Store, settings, launcher: Launcher) -> None:
+    def __init__(self, store: Store, settings, launcher: Launcher, hardware=None) -> None:
+        self.hardware = hardware  # server/service/hardware.py HardwareHub, or None
         self.store = store
         self.settings = settings
         self.launcher = launcher
@@ -166,6 +169,8 @@ class RunService:
 
     def start(self, user_id: str, request: RunRequest) -> RunRecord:
         spec = self.build_spec(request)
+        if request.hardware is not None:
+            spec = _replace(spec, clock=Clock.REALTIME)  # a real robot lives in real time
         with self._lock:
             if self._closing:
                 raise RunLimitError("the server is shutting down; try again in a minute", 60)
@@ -202,15 +207,60 @@ class RunService:
                 nodes={},
                 checks=[],
                 run_dir=str(run_dir),
+                hardware=request.hardware,
             )
             with self.store.session() as db:
                 run_store.add(db, record)
+            backend = None
+            if request.hardware is not None:
+                backend = self._claim_robot(request.hardware, user_id, run_id, spec)
             telemetry = self.telemetry.create(run_id)
-            run = Run(spec, self.launcher, run_dir, run_id=run_id)
+            run = Run(spec, self.launcher, run_dir, run_id=run_id, backend=backend)
             run.observer = _Watch(self, run_id, telemetry)
-            self._active[run_id] = ActiveRun(run, user_id, telemetry, exercise)
+            self._active[run_id] = ActiveRun(run, user_id, telemetry, exercise, request.hardware)
         self._pool.submit(self._execute, run_id)
         return record
+
+    def _claim_robot(self, name: str, user_id: str, run_id: str, spec: RunSpec):
+        """The bench robot for this run, if it is the user's turn (raises with a sentence)."""
+        from server.hardware.backend import HardwareRobot
+        from server.hardware.queue import QueueError
+        from server.hardware.safety import MotionLimits
+        from server.store import robots as inventory
+
+        if self.hardware is None:
+            raise RunRequestError("this server has no hardware support switched on")
+        with self.store.session() as db:
+            entry = inventory.by_name(db, name)
+            if entry is None:
+                names = ", ".join(e.name for e in inventory.listing(db)) or "none registered"
+                raise RunRequestError(f"no robot named '{name}' on the bench; robots: {names}")
+            kind, in_service = entry.kind, entry.in_service
+            limits, watchdog_s = dict(entry.limits), entry.watchdog_s
+        if kind != spec.robot:
+            raise RunRequestError(f"'{name}' is a {kind}; this run needs a {spec.robot}")
+        if not in_service:
+            raise RunRequestError(f"'{name}' is out of service; ask your instructor")
+        link = self.hardware.link(name)
+        if link is None:
+            raise RunRequestError(f"'{name}' is not connected; switch it on or ask your instructor")
+        try:
+            self.hardware.queue(name).start(user_id, run_id, time.monotonic())
+        except QueueError as error:
+            raise RunLimitError(str(error), self.settings.retry_after_s) from None
+        link.drain()
+        return HardwareRobot(kind, link, MotionLimits(**limits), watchdog_s)
+
+    def emergency_stop(self, run_id: str, who: str) -> bool:
+        """Stop a run now; on a real robot, zero velocity is sent from this thread at once."""
+        active = self._active.get(run_id)
+        if active is None:
+            return False
+        backend = active.run.backend
+        if backend is not None:
+            backend.stop()
+        active.run.stop(f"emergency stop by {who}")
+        return True
 
     # ------------------------------------------------------------------------------ running
     def _execute(self, run_id: str) -> None:
@@ -228,6 +278,8 @@ class RunService:
         finally:
             with self._lock:
                 self._active.pop(run_id, None)
+            if active.hardware is not None and self.hardware is not None:
+                self.hardware.queue(active.hardware).finish(run_id, time.monotonic())
             watch = run.observer
             if isinstance(watch, _Watch):
                 watch.release_end()

@@ -141,6 +141,7 @@ class RunRecord(Base):
     checks: Mapped[list] = mapped_column(JSON, default=list)  # exercise check results
     score: Mapped[float | None] = mapped_column(Float, nullable=True)  # 0..1, exercises only
     run_dir: Mapped[str] = mapped_column(Text)
+    hardware: Mapped[str | None] = mapped_column(String(64), nullable=True)  # bench robot name
 
 
 class RobotEntry(Base):

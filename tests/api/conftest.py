@@ -114,7 +114,10 @@ def start_server(
 ) -> LabServer:
     port = port or free_port()
     env = dict(os.environ)
-    env.update({"ROBODOJO_SANDBOX_POOL": "2", "PYTHONUNBUFFERED": "1"})
+    # Several test servers run at once: each takes any free rosserial port.
+    env.update(
+        {"ROBODOJO_SANDBOX_POOL": "2", "PYTHONUNBUFFERED": "1", "ROBODOJO_ROSSERIAL_PORT": "0"}
+    )
     env.update(env_extra or {})
     command = [sys.executable, "-m", "server.cli", "serve", "--port", str(port), "--data",
                str(data)]  # fmt: skip

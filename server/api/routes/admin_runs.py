@@ -114,4 +114,9 @@ def status(request: Request, _: Caller = Depends(instructor)) -> dict:
         },
         "queues": {"waiting_runs": 0, "note": "runs start at once or are refused with 429"},
         "database": request.app.state.store.dialect,
+        "hardware": {
+            "rosserial_port": request.app.state.hardware.port,
+            "listening": request.app.state.hardware.listen_error or "yes",
+            "problems": request.app.state.hardware.problems(),
+        },
     }

@@ -68,6 +68,10 @@ def _apply(op: str, command: dict, viewer, active) -> None:
     run = active.run
     if op == "stop":
         run.stop("stopped by the user")
+    elif op == "estop":
+        if run.backend is not None:
+            run.backend.stop()
+        run.stop("emergency stop by the user")
     elif op == "pause":
         run.pause()
     elif op == "resume":
@@ -90,8 +94,8 @@ def _apply(op: str, command: dict, viewer, active) -> None:
         run.teleop(str(command.get("key")), bool(command.get("pressed", True)))
     else:
         raise CommandError(
-            f"unknown op {op!r}; ops: subscribe, unsubscribe, stop, pause, resume, button, "
-            "light, goal, teleop"
+            f"unknown op {op!r}; ops: subscribe, unsubscribe, stop, estop, pause, resume, "
+            "button, light, goal, teleop"
         )
 
 

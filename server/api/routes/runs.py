@@ -52,6 +52,7 @@ def run_out(record: RunRecord, service: RunService, with_code: bool = False) -> 
         "clock": record.clock,
         "duration_s": record.duration_s,
         "seed": record.seed,
+        "hardware": record.hardware,
         "state": _live_state(active.run.state) if active else record.state,
         "reason": record.reason,
         "created_at": iso(record.created_at),
@@ -119,12 +120,23 @@ def create(body: RunCreate, request: Request, caller: Caller = Depends(current_u
             )
         catalog.check_robot(body.robot)
         catalog.check_world(body.world)
+    if body.hardware is not None and request.app.state.settings.hardware_gate:
+        from server.api.routes.hardware import gate_refusal, simulation_gate
+
+        robot = entry.exercise.robot if entry else body.robot
+        verdict = simulation_gate(
+            request, caller.id, entry.exercise.id if entry else None, robot,
+            [{"name": n.name, "code": n.code} for n in body.nodes],
+        )  # fmt: skip
+        if not verdict["passed"]:
+            return gate_refusal(verdict)
     request_ = RunRequest(
         robot=body.robot,
         world=body.world,
         exercise=entry,
         nodes=tuple((node.name, node.code) for node in body.nodes),
         teleop=body.teleop,
+        hardware=body.hardware,
         clock=Clock(body.clock) if body.clock else None,
         duration_s=body.duration,
         seed=body.seed,
@@ -183,6 +195,15 @@ def stop(
     who = "an instructor" if caller.is_instructor else "the user"
     reason = f"stopped by {who}" + (f": {body.reason}" if body and body.reason else "")
     return _command(request, caller, run_id, "stop", reason)
+
+
+@router.post("/{run_id}/estop", summary="Emergency stop: the robot stops now")
+def emergency_stop(run_id: str, request: Request, caller: Caller = Depends(current_user)) -> dict:
+    record = visible_run(request, caller, run_id)
+    who = "an instructor" if caller.is_instructor else "the user"
+    if not service_of(request).emergency_stop(record.id, who):
+        raise HTTPException(409, f"run {run_id} has ended ({record.state}); nothing to stop")
+    return {"ok": True, "id": run_id, "action": "estop"}
 
 
 @router.post("/{run_id}/pause", summary="Pause a lockstep run")

@@ -1,4 +1,4 @@
-"""robots on the bench
+"""robots on the bench, and which runs ran on one
 
 Revision ID: 0002
 Revises: 0001
@@ -29,7 +29,11 @@ def upgrade() -> None:
         sa.PrimaryKeyConstraint("id"),
         sa.UniqueConstraint("name"),
     )
+    with op.batch_alter_table("runs") as runs:
+        runs.add_column(sa.Column("hardware", sa.String(length=64), nullable=True))
 
 
 def downgrade() -> None:
+    with op.batch_alter_table("runs") as runs:
+        runs.drop_column("hardware")
     op.drop_table("robots")

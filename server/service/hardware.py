@@ -1,0 +1,183 @@
+"""The lab bench as the service sees it: robots that connected (over rosserial, for now),
+matched to their inventory entries, each with a fair queue, handed to runs as a `RobotLink`.
+
+    hub = HardwareHub(store, settings); hub.start()     # listens on settings.rosserial_port
+    link = hub.link("crowbot-1")                         # a connected robot, or None
+    hub.queue("crowbot-1").join(user_id, now)            # server/hardware/queue.py
+
+A robot is matched by the address it connects from (its inventory entry's `address`, the
+CrowBot's WiFi IP) and must offer the topics of its kind (the simulated robot's names and
+types); a mismatch is kept as a problem the instructor sees. The rosserial thread hands each
+message to the link's inbox (bounded: latest values win when a run is not reading).
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections import deque
+
+from server.hardware.queue import RobotQueue
+from server.hardware.rosserial import RobotConnection, RosserialHandler, RosserialServer
+from server.hardware.rosserial.messages import LogLevel
+from server.sim.registry import get_robot
+from server.store import robots as inventory
+from server.store.db import Store
+
+log = logging.getLogger("robodojo.hardware")
+INBOX_MAX = 1000  # messages waiting for a run: ~10 s of the CrowBot's topics; older ones go
+LOG_LINES_KEPT = 200  # per robot, for the instructor
+
+
+class RosserialLink:
+    """A rosserial connection as a `RobotLink` (server/hardware/backend.py)."""
+
+    def __init__(self, connection: RobotConnection, name: str) -> None:
+        self.connection = connection
+        self.name = name
+        self.connected = True
+        self.lost_reason = ""
+        self._inbox: deque[tuple[str, object, float]] = deque(maxlen=INBOX_MAX)
+        self._lock = threading.Lock()
+        self.logs: deque[str] = deque(maxlen=LOG_LINES_KEPT)
+
+    def send(self, topic: str, message: object) -> None:
+        self.connection.send(topic, message)
+
+    def take_received(self) -> list[tuple[str, object, float]]:
+        with self._lock:
+            taken = list(self._inbox)
+            self._inbox.clear()
+        return taken
+
+    def drain(self) -> None:
+        """Forget what arrived before a run started."""
+        with self._lock:
+            self._inbox.clear()
+
+    def push(self, topic: str, message: object) -> None:
+        with self._lock:
+            self._inbox.append((topic, message, time.monotonic()))
+
+    def lose(self, reason: str) -> None:
+        self.lost_reason = reason
+        self.connected = False
+
+
+class HardwareHub(RosserialHandler):
+    def __init__(self, store: Store, settings) -> None:
+        self.store = store
+        self.settings = settings
+        self._links: dict[str, RosserialLink] = {}
+        self._by_connection: dict[str, str] = {}  # connection id -> robot name
+        self._problems: dict[str, list[str]] = {}  # robot name or address -> sentences
+        self._queues: dict[str, RobotQueue] = {}
+        self._lock = threading.Lock()
+        self.server: RosserialServer | None = None
+        self.listen_error = ""
+
+    # ------------------------------------------------------------------ lifecycle
+    def start(self) -> None:
+        port = self.settings.rosserial_port
+        if port is None or port < 0:
+            self.listen_error = "rosserial is switched off (--rosserial-port -1)"
+            return
+        server = RosserialServer(self, host=self.settings.rosserial_host, port=port)
+        try:
+            server.start()
+        except OSError as error:  # a busy port must not stop the lab: simulation goes on
+            self.listen_error = f"{error}; real CrowBots cannot connect"
+            log.warning("%s", self.listen_error)
+            return
+        self.server = server
+        log.info("rosserial: CrowBots connect to port %d", server.port)
+
+    def stop(self) -> None:
+        if self.server is not None:
+            self.server.stop()
+
+    @property
+    def port(self) -> int | None:
+        return self.server.port if self.server is not None else None
+
+    # ------------------------------------------------------------------ rosserial thread
+    def on_robot_connected(self, robot: RobotConnection) -> None:
+        address = robot.peer[0]
+        with self.store.session() as db:
+            entry = inventory.by_address(db, "rosserial", address)
+            known = entry is not None
+            name, kind = (entry.name, entry.kind) if known else (address, None)
+        problems = list(robot.problems)
+        if not known:
+            problems.append(
+                f"a robot connected from {address}, which no inventory entry has: register it "
+                "(POST /api/admin/robots with this address) and reconnect it"
+            )
+        else:
+            offered = {t.name: t.message_type for t in robot.topics.values()}
+            for topic in get_robot(kind).topics():
+                if offered.get(topic.name) != topic.type_name:
+                    problems.append(
+                        f"{name} does not offer topic '{topic.name}' [{topic.type_name}] that a "
+                        f"{kind} has (it offers: {', '.join(sorted(offered)) or 'nothing'})"
+                    )
+        with self._lock:
+            self._problems[name] = problems
+            if known:
+                old = self._links.get(name)
+                if old is not None:
+                    old.lose("the robot connected again")
+                self._links[name] = RosserialLink(robot, name)
+                self._by_connection[robot.id] = name
+        for problem in problems:
+            log.warning("hardware: %s", problem)
+
+    def on_robot_disconnected(self, robot: RobotConnection, reason: str) -> None:
+        with self._lock:
+            name = self._by_connection.pop(robot.id, None)
+            link = self._links.get(name) if name else None
+            if link is not None and link.connection is robot:
+                del self._links[name]
+        if link is not None:
+            link.lose("robot disconnected")
+            log.info("hardware: %s disconnected (%s)", name, reason)
+
+    def on_message(self, robot: RobotConnection, topic: str, message) -> None:
+        link = self._link_of(robot)
+        if link is not None:
+            link.push(topic, message)
+
+    def on_log(self, robot: RobotConnection, level: LogLevel, line: str) -> None:
+        link = self._link_of(robot)
+        if link is not None:
+            link.logs.append(f"[{level.name.lower()}] {line}")
+
+    def _link_of(self, robot: RobotConnection) -> RosserialLink | None:
+        name = self._by_connection.get(robot.id)
+        return self._links.get(name) if name else None
+
+    # ------------------------------------------------------------------ the service's side
+    def link(self, name: str) -> RosserialLink | None:
+        with self._lock:
+            link = self._links.get(name)
+        return link if link is not None and link.connected else None
+
+    def queue(self, name: str) -> RobotQueue:
+        with self._lock:
+            queue = self._queues.get(name)
+            if queue is None:
+                queue = self._queues[name] = RobotQueue(name)
+            return queue
+
+    def connection_state(self, name: str) -> str:
+        if self.link(name) is not None:
+            problems = self._problems.get(name) or []
+            return (
+                "connected" if not problems else "connected with problems: " + "; ".join(problems)
+            )
+        return "not connected"
+
+    def problems(self) -> dict[str, list[str]]:
+        with self._lock:
+            return {name: list(p) for name, p in self._problems.items() if p}

@@ -1,0 +1,158 @@
+"""A student's rospy script that finished in simulation drives the emulated CrowBot firmware
+(rosserial over TCP, tests/hardware/crowbot_firmware.py) through `robodojo serve`: the
+simulation gate, the queue, the limits between the node and the wire, the emergency stop, the
+recording showing the commands reaching the robot, and a robot that disconnects."""
+
+from __future__ import annotations
+
+import io
+import time
+from collections.abc import Iterator
+
+import pytest
+from mcap.reader import make_reader
+
+from tests.api.conftest import LabServer, start_server, stop_server, wait_for_end
+from tests.hardware.crowbot_firmware import CrowBotFirmware
+
+ROSPY = """\
+import rospy
+from std_msgs.msg import Int32
+from geometry_msgs.msg import Twist
+
+rospy.init_node("approach")
+pub = rospy.Publisher("Control", Twist, queue_size=1)
+latest = {"cm": None}
+rospy.Subscriber("Distance", Int32, lambda msg: latest.update(cm=msg.data))
+rate = rospy.Rate(10)
+while not rospy.is_shutdown():
+    cmd = Twist()
+    if latest["cm"] is not None and latest["cm"] > 30:
+        cmd.linear.x = 0.1
+    pub.publish(cmd)
+    rate.sleep()
+"""
+
+
+@pytest.fixture(scope="module")
+def bench(tmp_path_factory) -> Iterator[tuple[LabServer, CrowBotFirmware]]:
+    server = start_server(tmp_path_factory.mktemp("bench"))
+    admin = server.admin()
+    port = admin.get("/api/admin/status").json()["hardware"]["rosserial_port"]
+    made = admin.post(
+        "/api/admin/robots", json={"name": "crowbot-1", "kind": "crowbot", "address": "127.0.0.1"}
+    )
+    assert made.status_code == 201, made.text
+    firmware = CrowBotFirmware("127.0.0.1", port).start()
+    assert firmware.wait_until(lambda: firmware.configured, 10), "the firmware did not negotiate"
+    deadline = time.monotonic() + 10
+    while admin.get("/api/admin/robots").json()["robots"][0]["connection"] != "connected":
+        assert time.monotonic() < deadline, admin.get("/api/admin/robots").json()
+        time.sleep(0.1)
+    server.close_clients()
+    yield server, firmware
+    firmware.stop()
+    stop_server(server)
+
+
+@pytest.fixture(autouse=True)
+def _close_bench_clients(request) -> Iterator[None]:
+    yield
+    if "bench" in request.fixturenames:
+        request.getfixturevalue("bench")[0].close_clients()
+
+
+def hardware_run(client, code: str, duration: float = 3.0):
+    return client.post(
+        "/api/runs",
+        json={"robot": "crowbot", "world": "wall_approach", "hardware": "crowbot-1",
+              "duration": duration, "nodes": [{"name": "approach", "code": code}]},
+    )  # fmt: skip
+
+
+def test_code_that_passed_in_simulation_drives_the_real_robot(bench):
+    server, firmware = bench
+    student = server.student("ada")
+    robots = student.get("/api/hardware").json()["robots"]
+    assert robots[0]["name"] == "crowbot-1" and robots[0]["connection"] == "connected"
+
+    refused = hardware_run(student, ROSPY)
+    assert refused.status_code == 409
+    assert refused.json()["gate"] == {
+        "passed": False,
+        "simulation_run": None,
+        "reason": refused.json()["detail"],
+    }
+    simulated = student.post(
+        "/api/runs",
+        json={"robot": "crowbot", "world": "wall_approach", "duration": 2,
+              "nodes": [{"name": "approach", "code": ROSPY}]},
+    ).json()  # fmt: skip
+    assert wait_for_end(student, simulated["id"])["state"] == "finished"
+
+    not_queued = hardware_run(student, ROSPY)
+    assert not_queued.status_code == 429 and "not in the queue" in not_queued.json()["detail"]
+    joined = student.post("/api/hardware/crowbot-1/queue").json()
+    assert joined["position"] == 1 and joined["state"] == "offered"
+
+    before = len(firmware.received_on("Control"))
+    started = hardware_run(student, ROSPY)
+    assert started.status_code == 201, started.text
+    assert started.json()["hardware"] == "crowbot-1" and started.json()["clock"] == "realtime"
+    run = wait_for_end(student, started.json()["id"], timeout_s=30)
+    assert run["state"] == "finished", run["reason"]
+
+    commands = firmware.received_on("Control")[before:]
+    assert len(commands) >= 15  # 10 Hz for 3 s reached the robot over rosserial
+    assert max(c.linear.x for c in commands) == pytest.approx(0.1, abs=1e-6)
+    assert (commands[-1].linear.x, commands[-1].angular.z) == (0.0, 0.0)  # zero at the end
+    assert list(firmware.received_on("Leds")[-1].data) == [0, 0, 0]  # LEDs off
+
+    recording = student.get(f"/api/runs/{run['id']}/recording.mcap").content
+    topics = {}
+    for _, channel, _message in make_reader(io.BytesIO(recording)).iter_messages():
+        topics[channel.topic] = topics.get(channel.topic, 0) + 1
+    assert topics["/Distance"] >= 40 and topics["/Control"] >= 15  # the robot's own readings
+    # The slot is given back: the queue is empty again.
+    assert student.get("/api/hardware").json()["robots"][0]["queue"]["places"] == []
+
+
+def test_the_emergency_stop_stops_the_robot_at_once(bench):
+    server, firmware = bench
+    student = server.student("bob")
+    code = ROSPY.replace("cmd.linear.x = 0.1", "cmd.linear.x = 0.05")
+    simulated = student.post(
+        "/api/runs",
+        json={"robot": "crowbot", "world": "wall_approach", "duration": 1,
+              "nodes": [{"name": "approach", "code": code}]},
+    ).json()  # fmt: skip
+    wait_for_end(student, simulated["id"])
+    student.post("/api/hardware/crowbot-1/queue")
+    run_id = hardware_run(student, code, duration=30).json()["id"]
+    assert firmware.wait_until(
+        lambda: any(c.linear.x > 0 for c in firmware.received_on("Control")[-3:]), 10
+    )
+    pressed = time.monotonic()
+    assert student.post(f"/api/runs/{run_id}/estop").json()["action"] == "estop"
+    assert firmware.wait_until(lambda: firmware.received_on("Control")[-1].linear.x == 0.0, 1)
+    stopped_after_s = time.monotonic() - pressed
+    run = wait_for_end(student, run_id)
+    assert run["state"] == "interrupted" and "emergency stop" in run["reason"]
+    assert stopped_after_s < 0.1  # within one 10 Hz control period
+
+
+def test_a_robot_that_disconnects_ends_its_run(bench):
+    server, firmware = bench
+    student = server.student("cleo")
+    simulated = student.post(
+        "/api/runs",
+        json={"robot": "crowbot", "world": "wall_approach", "duration": 1,
+              "nodes": [{"name": "approach", "code": ROSPY}]},
+    ).json()  # fmt: skip
+    wait_for_end(student, simulated["id"])
+    student.post("/api/hardware/crowbot-1/queue")
+    run_id = hardware_run(student, ROSPY, duration=30).json()["id"]
+    time.sleep(1.0)
+    firmware._close()  # the robot's WiFi drops
+    run = wait_for_end(student, run_id, timeout_s=20)
+    assert run["state"] == "failed" and run["reason"] == "failed: robot disconnected"
