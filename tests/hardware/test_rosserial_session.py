@@ -26,7 +26,7 @@ from server.hardware.rosserial.frames import (
     TopicId,
     encode_frame,
 )
-from server.hardware.rosserial.limits import DEFAULT_LIMITS
+from server.hardware.rosserial.limits import DEFAULT_LIMITS, RosserialLimits
 from server.hardware.rosserial.messages import LogLevel
 from server.hardware.rosserial.session import (
     RATE_LIMITED,
@@ -367,3 +367,9 @@ def test_the_outbox_is_bounded() -> None:
         session.send("Control", Twist())
     assert len(session.data_to_send()) <= 1024
     assert session.stats.outbox_dropped > 0
+
+
+def test_limits_must_be_positive() -> None:
+    with pytest.raises(ValueError, match=r"RosserialLimits\.idle_timeout_s must be positive"):
+        dataclasses.replace(DEFAULT_LIMITS, idle_timeout_s=0)
+    assert isinstance(DEFAULT_LIMITS, RosserialLimits)

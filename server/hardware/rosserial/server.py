@@ -90,12 +90,16 @@ class RobotConnection:
     """One robot's TCP connection and its session, as handlers see it."""
 
     def __init__(
-        self, server: RosserialServer, robot_id: str, peer: tuple[str, int], session
+        self,
+        server: RosserialServer,
+        robot_id: str,
+        peer: tuple[str, int],
+        session: RosserialSession,
     ) -> None:
         self._server = server
         self.id = robot_id
         self.peer = peer  # (host, port) of the robot
-        self.session: RosserialSession = session
+        self.session = session
         self.connected_at = time.time()  # [s] epoch
         self.announced = False  # on_robot_connected has been called
         self.outgoing_dropped = 0  # frames not written: the robot stopped reading
@@ -307,6 +311,11 @@ class RosserialServer:
         loop, thread = self._loop, self._thread
         if loop is None or thread is None or not thread.is_alive():
             return
+        if threading.current_thread() is thread:
+            raise RuntimeError(
+                "RosserialServer.stop() was called from a handler (the rosserial thread); call "
+                "robot.stop() there, or stop the server from another thread"
+            )
         future = asyncio.run_coroutine_threadsafe(self._shutdown(), loop)
         with contextlib.suppress(TimeoutError):
             future.result(timeout_s)
