@@ -31,6 +31,7 @@ def step(obs):
 RUN_ROUTES = {
     ("GET", "/api/runs/{run_id}"): "/api/runs/{id}",
     ("POST", "/api/runs/{run_id}/stop"): "/api/runs/{id}/stop",
+    ("POST", "/api/runs/{run_id}/estop"): "/api/runs/{id}/estop",
     ("POST", "/api/runs/{run_id}/pause"): "/api/runs/{id}/pause",
     ("POST", "/api/runs/{run_id}/resume"): "/api/runs/{id}/resume",
     ("GET", "/api/runs/{run_id}/recording.mcap"): "/api/runs/{id}/recording.mcap",
@@ -47,7 +48,7 @@ RUN_ROUTES = {
 }
 # Routes on the caller's own things with no id of someone else's in them: another student
 # reaches only their own (empty) data; shown by test_workspaces_are_private.
-OWN_ROUTES = {"/api/workspaces/", "/api/me", "/api/logout", "/api/session"}
+OWN_ROUTES = {"/api/workspaces/", "/api/me", "/api/logout", "/api/session", "/api/hardware"}
 PUBLIC_ROUTES = {"/login", "/", "/admin", "/api/health"}
 
 
