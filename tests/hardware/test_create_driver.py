@@ -17,8 +17,8 @@ serial = pytest.importorskip("serial", reason="CreateDriver needs pyserial")
 
 from sandbox.msgs import get_message_class  # noqa: E402
 from sandbox.msgs.geometry_msgs import Twist, Vector3  # noqa: E402
-from server.hardware.create import driver as driver_module  # noqa: E402
-from server.hardware.create import oi  # noqa: E402
+from server.hardware.create import oi, topics  # noqa: E402
+from server.hardware.create import port as port_module  # noqa: E402
 from server.hardware.create.driver import (  # noqa: E402
     CreateDriver,
     CreateNoAnswerError,
@@ -101,12 +101,12 @@ def test_topics_and_types_match_the_simulated_turtlebot(emulator, recorder):
 
     robot = TurtleBot()
     sensors = robot.build_sensors()
-    assert driver_module.TOPIC_CMD_VEL in robot.commands
-    assert robot.commands[driver_module.TOPIC_CMD_VEL][0] is Twist
+    assert topics.TOPIC_CMD_VEL in robot.commands
+    assert robot.commands[topics.TOPIC_CMD_VEL][0] is Twist
     driver = open_driver(emulator, recorder)
     try:
         assert wait_for(lambda: recorder.topic("odom") and recorder.topic("bumper"))
-        for topic in (driver_module.TOPIC_ODOM, driver_module.TOPIC_BUMPER):
+        for topic in (topics.TOPIC_ODOM, topics.TOPIC_BUMPER):
             assert type(recorder.topic(topic)[-1]) is sensors[topic].msg_type
         odom = recorder.topic("odom")[-1]
         assert (odom.header.frame_id, odom.child_frame_id) == ("odom", "base_link")
@@ -401,9 +401,20 @@ def test_permission_denied_says_what_to_do(monkeypatch):
     def refuse(*args, **kwargs):
         raise serial.SerialException(errno.EACCES, "could not open port: [Errno 13] denied")
 
-    monkeypatch.setattr(driver_module.serial, "Serial", refuse)
+    monkeypatch.setattr(port_module.serial, "Serial", refuse)
     with pytest.raises(CreatePortError, match="permission denied: add the server's user"):
         CreateDriver("/dev/ttyUSB0").open()
+
+
+def test_a_port_in_use_says_so(emulator, recorder):
+    driver = open_driver(emulator, recorder)
+    try:
+        second = CreateDriver(emulator.port)
+        with pytest.raises(CreatePortError, match="another program holds the port"):
+            second.open()
+        assert driver.state is CreateState.STREAMING
+    finally:
+        driver.close()
 
 
 def test_a_robot_that_does_not_answer():

@@ -24,9 +24,7 @@ Use `mode="full"` only on a table-free floor, for exercises that need to drive o
 
 from __future__ import annotations
 
-import errno
 import logging
-import math
 import threading
 import time
 from collections.abc import Callable
@@ -36,35 +34,37 @@ from typing import Literal
 
 import serial
 
-from sandbox.msgs import Time, get_message_class
-from server.hardware.create import kinematics, oi
+from server.hardware.create import kinematics, oi, topics
+from server.hardware.create.port import (
+    CreateError,
+    CreateNoAnswerError,
+    CreatePortError,
+    CreateStateError,
+    open_serial,
+)
 
 logger = logging.getLogger(__name__)
 
-TOPIC_CMD_VEL = "cmd_vel"
-TOPIC_ODOM = "odom"
-TOPIC_BUMPER = "bumper"
+__all__ = [
+    "CreateDriver",
+    "CreateError",
+    "CreateNoAnswerError",
+    "CreatePortError",
+    "CreateState",
+    "CreateStateError",
+]
 
 # The packets streamed, in this order.
 STREAM_PACKETS = (oi.BUMPS_WHEEL_DROPS, oi.OI_MODE, oi.LEFT_ENCODER_COUNTS, oi.RIGHT_ENCODER_COUNTS)
 
-# Defaults
-# | name                 | value   | why                                                         |
-# |----------------------|---------|-------------------------------------------------------------|
+# Defaults, and why.
 DEFAULT_BAUD = 115200  # Roomba 500/600 and Create 2 OI default (Create 1: 57600)
 CONNECT_TIMEOUT_S = 2.0  # [s] Start + Safe + first frame take ~50 ms; 2 s is a robot that is off
 SILENCE_TIMEOUT_S = 0.5  # [s] 33 missed 15 ms frames: no longer a hiccup of the USB adapter
 COMMAND_LATCH_S = 0.5  # [s] a cmd_vel older than this is replaced by zero velocity. create_robot
 #                        (the thesis's driver) latches 0.2 s; its Stanley controller ran at 5 Hz,
 #                        so 0.2 s would stutter it. None turns the latch off (the simulator's way).
-PUBLISH_RATE_HZ = 20.0  # [Hz] the simulated turtlebot's odom and bumper rate
 MODE_CHANGE_PAUSE_S = 0.02  # [s] assumption: time for the OI to switch mode before the next one
-READ_TIMEOUT_S = 0.02  # [s] the reader wakes this often to check silence and the latch
-WRITE_TIMEOUT_S = 1.0  # [s] a write that blocks this long means the adapter is gone
-# Odometry variances, as the simulated base reports them (server/sim/sensors/odometry.py):
-# pose (x, y, z, roll, pitch, yaw) [m^2, rad^2], twist [(m/s)^2, (rad/s)^2]; 1e6 = unobservable.
-POSE_VARIANCES = (1e-3, 1e-3, 1e6, 1e6, 1e6, 1e-2)
-TWIST_VARIANCES = (1e-4, 1e-6, 1e6, 1e6, 1e6, 1e-3)
 
 
 class CreateState(Enum):
@@ -88,63 +88,8 @@ _TRANSITIONS: dict[CreateState, frozenset[CreateState]] = {
 }
 
 
-class CreateError(Exception):
-    """Something about the robot or its port; the message says what to do."""
-
-
-class CreatePortError(CreateError):
-    """The serial port cannot be opened (missing, no permission, in use)."""
-
-
-class CreateNoAnswerError(CreateError):
-    """The port opened but no sensor stream came back."""
-
-
-class CreateStateError(CreateError):
-    """A call the driver's current state does not allow."""
-
-
 OnMessage = Callable[[str, object], None]
 OnState = Callable[[CreateState, str | None], None]
-
-
-def _diagonal(variances: tuple[float, ...]) -> list[float]:
-    size = len(variances)
-    flat = [0.0] * (size * size)
-    for index, variance in enumerate(variances):
-        flat[index * size + index] = float(variance)
-    return flat
-
-
-def _open_serial(port: str, baud: int) -> serial.Serial:
-    """pyserial's port, or a CreatePortError that says why not and what to do."""
-    try:
-        return serial.Serial(
-            port,
-            baudrate=baud,
-            timeout=READ_TIMEOUT_S,
-            write_timeout=WRITE_TIMEOUT_S,
-            exclusive=True,
-        )
-    except ValueError as exc:
-        raise CreatePortError(f"cannot open {port} at {baud} baud: {exc}") from exc
-    except serial.SerialException as exc:
-        code = getattr(exc, "errno", None)
-        if code == errno.ENOENT:
-            hint = (
-                "there is no such device: is the USB-serial cable plugged in? "
-                "`ls /dev/ttyUSB* /dev/ttyACM*` lists the ports there are"
-            )
-        elif code in (errno.EACCES, errno.EPERM):
-            hint = (
-                "permission denied: add the server's user to the port's group "
-                "(`sudo usermod -aG dialout $USER`, then log in again)"
-            )
-        elif code in (errno.EBUSY, errno.EAGAIN, errno.EWOULDBLOCK):
-            hint = "another program holds the port: close it (`fuser` names it) and retry"
-        else:
-            hint = str(exc)
-        raise CreatePortError(f"cannot open the Create's serial port {port}: {hint}") from exc
 
 
 class CreateDriver:
@@ -167,7 +112,7 @@ class CreateDriver:
         connect_timeout_s: float = CONNECT_TIMEOUT_S,
         silence_timeout_s: float = SILENCE_TIMEOUT_S,
         command_latch_s: float | None = COMMAND_LATCH_S,
-        publish_rate_hz: float = PUBLISH_RATE_HZ,
+        publish_rate_hz: float = topics.PUBLISH_RATE_HZ,
         frame_id: str = "odom",
         child_frame_id: str = "base_link",
     ) -> None:
@@ -175,8 +120,6 @@ class CreateDriver:
             raise ValueError(f"mode must be 'safe' or 'full', got {mode!r}")
         if stop_with not in ("passive", "off"):
             raise ValueError(f"stop_with must be 'passive' or 'off', got {stop_with!r}")
-        if publish_rate_hz <= 0.0:
-            raise ValueError(f"publish_rate_hz must be > 0, got {publish_rate_hz}")
         self.port = port
         self.baud = int(baud)
         self.mode = mode
@@ -187,12 +130,9 @@ class CreateDriver:
         self.connect_timeout_s = float(connect_timeout_s)
         self.silence_timeout_s = float(silence_timeout_s)
         self.command_latch_s = command_latch_s
-        self.publish_period_s = 1.0 / publish_rate_hz
-        self.frame_id = frame_id
-        self.child_frame_id = child_frame_id
-
-        self._odometry_cls = get_message_class("nav_msgs/Odometry")
-        self._bumper_cls = get_message_class("std_msgs/Int32MultiArray")
+        self._topics = topics.CreateTopics(
+            publish_rate_hz=publish_rate_hz, frame_id=frame_id, child_frame_id=child_frame_id
+        )
         self._state = CreateState.NEW
         self._problem: str | None = None
         self._mode_problem: str | None = None  # the robot is not in the mode asked for
@@ -203,18 +143,9 @@ class CreateDriver:
         self._stop_reading = threading.Event()
         self._first_frame = threading.Event()
         self._parser = oi.StreamParser(packet_ids=STREAM_PACKETS)
-        self._odometry = kinematics.EncoderOdometry()
         self._bytes_received = 0
         self._oi_mode: oi.OIMode | None = None
-        self._bumper: tuple[int, int] | None = None
-        self._wheel_drop = False
         self._last_command_s: float | None = None  # monotonic time of the last nonzero command
-        # Motion since the last odom message, for its twist.
-        self._window_distance_m = 0.0
-        self._window_yaw_rad = 0.0
-        self._window_steps = 0  # encoder samples in the window, one per 15 ms frame
-        self._window_start_s: float | None = None  # monotonic
-        self._last_publish_s: float | None = None  # monotonic
 
     # --- state -------------------------------------------------------------------------------
 
@@ -241,7 +172,7 @@ class CreateDriver:
     @property
     def pose(self) -> kinematics.Pose2D:
         """The integrated odometry pose."""
-        return self._odometry.pose
+        return self._topics.odometry.pose
 
     def _transition(self, new_state: CreateState, reason: str | None = None) -> None:
         with self._state_lock:
@@ -271,13 +202,12 @@ class CreateDriver:
                 "Make a new CreateDriver to reconnect."
             )
         try:
-            self._serial = _open_serial(self.port, self.baud)
+            self._serial = open_serial(self.port, self.baud)
         except CreatePortError:
             self._transition(CreateState.CLOSED)
             raise
         self._transition(CreateState.CONNECTING)
         try:
-            self._serial.reset_input_buffer()
             self._write(oi.encode_opcode(oi.Opcode.START))
             time.sleep(MODE_CHANGE_PAUSE_S)
             self._write(oi.encode_opcode(self._mode_opcode()))
@@ -467,33 +397,14 @@ class CreateDriver:
                 self._on_port_failure(str(exc))
 
     def _on_frames(self, frames: list[dict[int, int]], now_s: float) -> None:
-        stamp_s = self.clock()
-        bumper_changed = False
+        for message_topic, message in self._topics.on_frames(frames, now_s, self.clock()):
+            self._publish(message_topic, message)
         for packets in frames:
-            step = self._odometry.update(
-                packets[oi.LEFT_ENCODER_COUNTS], packets[oi.RIGHT_ENCODER_COUNTS]
-            )
-            self._window_distance_m += step.distance_m
-            self._window_yaw_rad += step.yaw_change_rad
-            self._window_steps += 1
-            bits = packets[oi.BUMPS_WHEEL_DROPS]
-            bumper = (int(bool(bits & oi.BUMP_LEFT_BIT)), int(bool(bits & oi.BUMP_RIGHT_BIT)))
-            bumper_changed |= bumper != self._bumper
-            self._bumper = bumper
-            self._wheel_drop = bool(bits & (oi.WHEEL_DROP_LEFT_BIT | oi.WHEEL_DROP_RIGHT_BIT))
             self._on_oi_mode(packets[oi.OI_MODE])
-        if self._window_start_s is None:
-            self._window_start_s = now_s
         if not self._first_frame.is_set():
             self._first_frame.set()
         elif self._state is CreateState.SILENT:
             self._transition(CreateState.STREAMING)
-        due = self._last_publish_s is None or now_s - self._last_publish_s >= self.publish_period_s
-        if due:
-            self._publish(TOPIC_ODOM, self._odometry_message(stamp_s, now_s))
-            self._last_publish_s = now_s
-        if due or bumper_changed:
-            self._publish(TOPIC_BUMPER, self._bumper_cls(data=list(self._bumper or (0, 0))))
 
     def _on_oi_mode(self, value: int) -> None:
         try:
@@ -507,44 +418,16 @@ class CreateDriver:
         if mode == wanted:
             self._mode_problem = None
             return
-        cause = "a wheel dropped" if self._wheel_drop else "a cliff, a wheel drop or the charger"
+        cause = (
+            "a wheel dropped"
+            if self._topics.wheel_dropped
+            else "a cliff, a wheel drop or the charger"
+        )
         self._mode_problem = (
             f"the Create is in {mode.name.title()} mode, not {wanted.name.title()} ({cause}?): "
             "it ignores drive commands now; check the robot, then call rearm()"
         )
         logger.warning(self._mode_problem)
-
-    def _window_duration_s(self, now_s: float) -> float:
-        """How long the motion in the window took [s]. The robot sends a frame every 15 ms on
-        its own clock, so frames x 15 ms beats the host's receive times, which bunch frames up
-        (a USB adapter or a busy host delivers two or three at once: +-50% speed jitter at
-        20 Hz). Unless frames were lost: then the host's time is the better count."""
-        host_s = now_s - (self._window_start_s if self._window_start_s is not None else now_s)
-        robot_s = self._window_steps * oi.STREAM_PERIOD_S
-        return host_s if host_s > robot_s + 3 * oi.STREAM_PERIOD_S else robot_s
-
-    def _odometry_message(self, stamp_s: float, now_s: float) -> object:
-        window_s = self._window_duration_s(now_s)
-        linear_m_s = self._window_distance_m / window_s if window_s > 0 else 0.0
-        angular_rad_s = self._window_yaw_rad / window_s if window_s > 0 else 0.0
-        self._window_distance_m = 0.0
-        self._window_yaw_rad = 0.0
-        self._window_steps = 0
-        self._window_start_s = now_s
-        pose = self._odometry.pose
-        message = self._odometry_cls()
-        message.header.stamp = Time.from_sec(stamp_s)
-        message.header.frame_id = self.frame_id
-        message.child_frame_id = self.child_frame_id
-        message.pose.pose.position.x = pose.x_m
-        message.pose.pose.position.y = pose.y_m
-        message.pose.pose.orientation.z = math.sin(0.5 * pose.yaw_rad)
-        message.pose.pose.orientation.w = math.cos(0.5 * pose.yaw_rad)
-        message.pose.covariance = _diagonal(POSE_VARIANCES)
-        message.twist.twist.linear.x = linear_m_s
-        message.twist.twist.angular.z = angular_rad_s
-        message.twist.covariance = _diagonal(TWIST_VARIANCES)
-        return message
 
     def _publish(self, topic: str, message: object) -> None:
         if self.on_message is None:
