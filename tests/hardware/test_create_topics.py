@@ -102,3 +102,13 @@ def test_a_spin_reports_yaw_and_yaw_rate():
 def test_a_bad_rate_is_refused():
     with pytest.raises(ValueError, match="publish_rate_hz must be > 0"):
         topics.CreateTopics(publish_rate_hz=0.0)
+
+
+def test_twenty_hz_on_average_from_15_ms_frames():
+    state = topics.CreateTopics(publish_rate_hz=20.0)
+    frames = straight(200)  # 3 s
+    published = sum(
+        len(by_topic(state.on_frames([f], i * PERIOD_S, i * PERIOD_S), "odom"))
+        for i, f in enumerate(frames)
+    )
+    assert published == pytest.approx(200 * PERIOD_S * 20.0, abs=1)

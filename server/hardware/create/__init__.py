@@ -1,3 +1,11 @@
-"""The iRobot Create/Roomba base over its Open Interface (pyserial): `oi` (the wire format),
-`kinematics` (wheel speeds and encoder odometry), `driver` (`CreateDriver`, the serial port and
-the turtlebot's topics cmd_vel, odom, bumper)."""
+"""The iRobot Create/Roomba base over its Open Interface (pyserial), presenting the simulated
+turtlebot's topics cmd_vel, odom and bumper.
+
+- `oi`: the wire format (opcodes, sensor packets, command bytes, the stream frame parser);
+- `kinematics`: wheel speeds from a Twist, odometry from the encoder counts;
+- `topics`: stream frames -> odom and bumper messages;
+- `port`: opening the serial port, and the errors, each a sentence;
+- `driver`: `CreateDriver`, the lifecycle and the reader thread.
+
+Only `driver` and `port` need pyserial.
+"""

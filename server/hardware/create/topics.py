@@ -10,6 +10,7 @@ Pure: the caller passes the frames and the times; no port, no thread, no clock.
   holds bytes for its latency timer and a busy host reads late, and at 20 Hz a frame more or
   less in a window is +-30% speed. When frames went missing (the host's time is longer than
   the frames account for by 3 periods) the host's time is used.
+- Rate: `publish_rate_hz` on average, on a fixed schedule met by the next frame.
 - bumper: packet 7's bump bits, published with each odom message and at once when a switch
   changes (a bump should not wait up to 50 ms).
 """
@@ -67,7 +68,7 @@ class CreateTopics:
         self._window_yaw_rad = 0.0
         self._window_frames = 0
         self._window_start_s: float | None = None
-        self._last_publish_s: float | None = None
+        self._next_publish_s: float | None = None  # on a fixed schedule: 20 Hz on average
 
     def on_frames(
         self, frames: Iterable[dict[int, int]], now_s: float, stamp_s: float
@@ -90,10 +91,14 @@ class CreateTopics:
         if self._window_start_s is None:
             self._window_start_s = now_s
         out: list[tuple[str, Message]] = []
-        due = self._last_publish_s is None or now_s - self._last_publish_s >= self.publish_period_s
+        due = self._next_publish_s is None or now_s >= self._next_publish_s
         if due:
             out.append((TOPIC_ODOM, self._odometry_message(now_s, stamp_s)))
-            self._last_publish_s = now_s
+            # Keep the schedule (frames come every 15 ms, so "50 ms since the last" would give
+            # 60 ms gaps, 16.7 Hz); after a stall, start it again from now.
+            if self._next_publish_s is None or now_s - self._next_publish_s > self.publish_period_s:
+                self._next_publish_s = now_s
+            self._next_publish_s += self.publish_period_s
         if self.bumper is not None and (due or bumper_changed):
             out.append((TOPIC_BUMPER, self._bumper_cls(data=list(self.bumper))))
         return out
