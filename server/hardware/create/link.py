@@ -1,0 +1,81 @@
+"""`CreateLink`: a `CreateDriver` as a `RobotLink` (server/hardware/backend.py), so a Run can
+drive a real Create/Roomba base through `HardwareRobot("turtlebot", link, limits)` as it drives
+a rosserial CrowBot.
+
+    link = CreateLink("/dev/ttyUSB0")
+    link.open()                        # CreatePortError / CreateNoAnswerError, with a sentence
+    robot = HardwareRobot("turtlebot", link, limits)
+    ...
+    link.close()                       # zero velocity, Passive, port released
+
+The driver's reader thread pushes odom and bumper into a bounded inbox (latest values win when
+no run is reading); `take_received()` hands them over with their monotonic receive times.
+`connected` is true only while frames stream: a silent robot (0.5 s without a frame, see
+driver.SILENCE_TIMEOUT_S) ends the run, since its odometry is frozen and nothing says whether
+it still obeys.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections import deque
+
+from server.hardware.create.driver import CreateDriver, CreateState
+from server.hardware.create.topics import TOPIC_CMD_VEL
+
+INBOX_MAX = 1000  # messages waiting for a run: 25 s of odom + bumper at 20 Hz; older ones go
+
+
+class CreateLink:
+    """See module doc. Options other than `inbox_max` go to `CreateDriver`."""
+
+    def __init__(
+        self, port: str, baud: int | None = None, *, inbox_max: int = INBOX_MAX, **options
+    ):
+        if "on_message" in options:
+            raise TypeError("CreateLink owns on_message; read messages with take_received()")
+        if baud is not None:
+            options["baud"] = baud
+        self.driver = CreateDriver(port, on_message=self._push, **options)
+        self._inbox: deque[tuple[str, object, float]] = deque(maxlen=inbox_max)
+        self._lock = threading.Lock()
+
+    def open(self) -> None:
+        self.driver.open()
+
+    def close(self) -> None:
+        self.driver.close()
+
+    @property
+    def connected(self) -> bool:
+        return self.driver.state is CreateState.STREAMING
+
+    @property
+    def lost_reason(self) -> str:
+        if self.connected:
+            return ""
+        return self.driver.problem or f"the Create driver is {self.driver.state.value}"
+
+    def send(self, topic: str, message: object) -> None:
+        if topic != TOPIC_CMD_VEL:
+            raise ValueError(
+                f"the Create base takes only {TOPIC_CMD_VEL!r} (geometry_msgs/Twist), not {topic!r}"
+            )
+        self.driver.command(message)
+
+    def take_received(self) -> list[tuple[str, object, float]]:
+        """(topic, message, monotonic receive time [s]) since the last call."""
+        with self._lock:
+            taken = list(self._inbox)
+            self._inbox.clear()
+        return taken
+
+    def drain(self) -> None:
+        """Forget what arrived before a run started."""
+        with self._lock:
+            self._inbox.clear()
+
+    def _push(self, topic: str, message: object) -> None:
+        with self._lock:
+            self._inbox.append((topic, message, time.monotonic()))

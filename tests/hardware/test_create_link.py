@@ -1,0 +1,89 @@
+"""CreateLink: a Create on the bench as the RobotLink a hardware run drives
+(server/hardware/backend.py), against the pty emulator."""
+
+from __future__ import annotations
+
+import time
+
+import pytest
+
+pytest.importorskip("serial", reason="CreateLink needs pyserial")
+
+from sandbox.msgs.geometry_msgs import Twist, Vector3
+from server.hardware.backend import HardwareRobot, RobotLost
+from server.hardware.create import oi
+from server.hardware.create.link import CreateLink
+from server.hardware.safety import MotionLimits
+from tests.hardware.create_emulator import CreateEmulator
+
+LIMITS = MotionLimits(
+    max_linear_m_s=0.3,
+    max_angular_rad_s=2.0,
+    max_linear_accel_m_s2=10.0,
+    max_angular_accel_rad_s2=50.0,
+)
+
+
+def test_a_hardware_run_drives_the_create_and_reads_odom_and_bumper():
+    with CreateEmulator() as emulator:
+        link = CreateLink(emulator.port)
+        link.open()
+        try:
+            robot = HardwareRobot("turtlebot", link, LIMITS)
+            robot.reset()
+            published = []
+            end = time.monotonic() + 0.5
+            while time.monotonic() < end:
+                robot.apply("cmd_vel", Twist(linear=Vector3(x=0.2)))
+                published += robot.step(0.02)
+                time.sleep(0.02)
+            robot.stop()
+            time.sleep(0.1)
+            published += robot.step(0.1)
+            topics = {p.topic for p in published}
+            assert topics == {"odom", "bumper"}
+            assert emulator.commands(oi.Opcode.DRIVE_DIRECT)[-1] == bytes(4)
+            odom = robot.read("odom")
+            assert odom.pose.pose.position.x == pytest.approx(emulator.pose()[0], abs=0.01)
+            assert odom.pose.pose.position.x > 0.05
+            times = [p.time_s for p in published]
+            assert times == sorted(times)
+        finally:
+            link.close()
+
+
+def test_a_silent_create_ends_the_run_with_the_drivers_sentence():
+    with CreateEmulator() as emulator:
+        link = CreateLink(emulator.port, silence_timeout_s=0.1)
+        link.open()
+        try:
+            robot = HardwareRobot("turtlebot", link, LIMITS)
+            robot.reset()
+            assert link.connected and link.lost_reason == ""
+            emulator.go_silent()
+            deadline = time.monotonic() + 2.0
+            while link.connected and time.monotonic() < deadline:
+                time.sleep(0.01)
+            with pytest.raises(RobotLost, match="no sensor frame from the Create"):
+                robot.step(0.02)
+        finally:
+            link.close()
+
+
+def test_only_cmd_vel_is_taken_and_the_inbox_is_bounded():
+    with CreateEmulator() as emulator:
+        link = CreateLink(emulator.port, inbox_max=5)
+        link.open()
+        try:
+            with pytest.raises(ValueError, match="takes only 'cmd_vel'"):
+                link.send("Leds", object())
+            time.sleep(0.5)  # ~20 messages arrive; the 5 newest are kept
+            taken = link.take_received()
+            assert len(taken) == 5
+            assert [t for t in taken if t[2] > time.monotonic()] == []
+            link.drain()
+            assert link.take_received() == []
+        finally:
+            link.close()
+    assert not link.connected
+    assert link.lost_reason == "the Create driver is closed"
