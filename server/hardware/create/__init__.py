@@ -5,7 +5,8 @@ turtlebot's topics cmd_vel, odom and bumper.
 - `kinematics`: wheel speeds from a Twist, odometry from the encoder counts;
 - `topics`: stream frames -> odom and bumper messages;
 - `port`: opening the serial port, and the errors, each a sentence;
-- `driver`: `CreateDriver`, the lifecycle and the reader thread.
+- `driver`: `CreateDriver`, the lifecycle and the reader thread;
+- `link`: `CreateLink`, the driver as the `RobotLink` a hardware run drives.
 
-Only `driver` and `port` need pyserial.
+Only `driver`, `port` and `link` need pyserial.
 """

@@ -32,7 +32,7 @@ class CreateLink:
 
     def __init__(
         self, port: str, baud: int | None = None, *, inbox_max: int = INBOX_MAX, **options
-    ):
+    ) -> None:
         if "on_message" in options:
             raise TypeError("CreateLink owns on_message; read messages with take_received()")
         if baud is not None:
