@@ -20,7 +20,7 @@ from server.hardware.rosserial.frames import REQUEST_TOPICS_FRAME, TX_STOP_FRAME
 from server.hardware.rosserial.limits import DEFAULT_LIMITS
 from server.hardware.rosserial.messages import LogLevel
 from server.hardware.rosserial.server import RobotConnection, RosserialHandler, RosserialServer
-from server.hardware.rosserial.session import SessionState, TopicError
+from server.hardware.rosserial.session import RobotDisconnected, SessionState, TopicError
 from tests.hardware.crowbot_firmware import (
     PUBLISHER_IDS,
     WRONG_MD5,
@@ -164,8 +164,9 @@ def test_stop_sends_tx_stop_and_the_robot_stops_publishing() -> None:
         assert wait_until(lambda: robot_fw.tx_stops == 1 and not robot_fw.configured)
         assert wait_until(lambda: handler.disconnected and not robot_fw.connected)
         assert handler.disconnected[0][1] == "stopped by RoboDojo (tx stop sent)"
-        assert server.robots() == []
-        with pytest.raises(Exception, match="disconnected"):
+        assert server.robots() == [] and not robot.connected
+        assert robot.close_reason == "stopped by RoboDojo (tx stop sent)"
+        with pytest.raises(RobotDisconnected, match="the robot is disconnected"):
             robot.send("Control", Twist())
 
 
@@ -294,7 +295,9 @@ def test_a_garbage_flood_keeps_memory_flat_and_the_good_robot_served() -> None:
         assert sent > 256 * 1024  # the flood filled the byte budget...
         assert flooder.reads_paused >= 1  # ...and reading paused at the limit
         assert flooder.session.stats.bytes_in <= 256 * 1024 * (flood_s + 2)
-        assert max(buffered) <= flooder.session.parser.max_buffered_bytes
+        # Sampled from this thread, possibly mid-feed: one read buffer on top of the held frame.
+        bound = flooder.session.parser.max_buffered_bytes + server.limits.read_buffer_bytes
+        assert max(buffered) <= bound
         assert rss_growth < 20 * 1024 * 1024, rss_growth
         assert handler.connected[0].state is SessionState.READY
 

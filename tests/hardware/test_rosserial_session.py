@@ -30,6 +30,7 @@ from server.hardware.rosserial.limits import DEFAULT_LIMITS, RosserialLimits
 from server.hardware.rosserial.messages import LogLevel
 from server.hardware.rosserial.session import (
     RATE_LIMITED,
+    RobotDisconnected,
     RosserialSession,
     SessionError,
     SessionState,
@@ -228,7 +229,7 @@ def test_stop_sends_tx_stop_and_closes() -> None:
     assert session.data_to_send() == TX_STOP_FRAME
     assert session.state is SessionState.CLOSED
     assert session.stop() == [] and session.data_to_send() == b""
-    with pytest.raises(SessionError, match=r"disconnected .*stopped by RoboDojo"):
+    with pytest.raises(RobotDisconnected, match=r"disconnected .*stopped by RoboDojo"):
         session.send("Control", Twist())
     with pytest.raises(SessionError, match="closed session"):
         session.receive_data(distance_frame(1), T0)

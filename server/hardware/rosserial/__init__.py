@@ -20,6 +20,7 @@ from server.hardware.rosserial.server import (
     RosserialServer,
 )
 from server.hardware.rosserial.session import (
+    RobotDisconnected,
     RosserialSession,
     SessionError,
     SessionState,
@@ -35,6 +36,7 @@ __all__ = [
     "FrameParser",
     "LogLevel",
     "RobotConnection",
+    "RobotDisconnected",
     "RobotTopic",
     "RosserialHandler",
     "RosserialLimits",

@@ -111,6 +111,16 @@ class RobotConnection:
         return self.session.state
 
     @property
+    def connected(self) -> bool:
+        """False once the session closed (a send() then raises RobotDisconnected)."""
+        return self.session.state is not SessionState.CLOSED
+
+    @property
+    def close_reason(self) -> str | None:
+        """Why the session closed, as a sentence (None while connected)."""
+        return self.session.close_reason
+
+    @property
     def topics(self) -> dict[str, RobotTopic]:
         """Accepted topics by name, both directions."""
         return {**self.session.publishers, **self.session.subscribers}
@@ -125,9 +135,11 @@ class RobotConnection:
         return self.session.drops
 
     def send(self, topic: str, message: Message) -> None:
-        """Send `message` on a topic the robot subscribes to; any thread. Raises TopicError or
-        SessionError at once; the frame is written on the rosserial thread (dropped and counted
-        in ``outgoing_dropped`` when the robot has not read the last ~16 KiB)."""
+        """Send `message` on a topic the robot subscribes to; any thread.
+
+        Raises TopicError or RobotDisconnected (a SessionError) at once, in the caller's thread;
+        the frame is written on the rosserial thread (dropped and counted in
+        ``outgoing_dropped`` when the robot has not read the last ~16 KiB)."""
         frame = self.session.encode(topic, message)
         self._server._call_on_loop(self._write_frame, frame)
 

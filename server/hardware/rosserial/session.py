@@ -110,6 +110,10 @@ class SessionError(RuntimeError):
     """A call the session cannot take in its current state; the message says what to do."""
 
 
+class RobotDisconnected(SessionError):
+    """``send()`` after the session closed (the robot went away, or was stopped)."""
+
+
 class TopicError(ValueError):
     """``send()`` to a topic the robot does not subscribe to, or with the wrong message."""
 
@@ -415,7 +419,7 @@ class RosserialSession:
         """The frame carrying `message` on `topic`, checked; no state changes (thread-safe to
         call while the connection thread runs the session, as it only reads topic tables)."""
         if self.state is SessionState.CLOSED:
-            raise SessionError(
+            raise RobotDisconnected(
                 f"the robot is disconnected ({self.close_reason}); wait for it to reconnect"
             )
         target = self.subscribers.get(topic)
