@@ -395,3 +395,29 @@ def test_tx_stop_bytes_on_the_wire() -> None:
         server.robots()[0].stop()
         received = read_until_closed(peer, 3.0)
         assert received.startswith(REQUEST_TOPICS_FRAME) and received.endswith(TX_STOP_FRAME)
+
+
+def test_a_groovy_era_firmware_is_explained_not_connected() -> None:
+    handler = Recorder()
+    with serving(handler) as server, firmware(server, protocol_version=0xFF) as robot_fw:
+        # ros_lib sees our 0xFE, and (unconfigured) answers with a time request in its 0xFF.
+        assert wait_until(lambda: robot_fw.receiver.version_mismatches >= 1)
+        assert wait_until(lambda: any("Mismatched protocol version" in p for p in problems(server)))
+        (problem,) = problems(server)
+        assert "Rev 0 (rosserial 0.4 and earlier, ROS Groovy)" in problem
+        assert handler.connected == [] and not robot_fw.configured
+
+
+def problems(server: RosserialServer) -> list[str]:
+    return [p for robot in server.robots() for p in robot.problems]
+
+
+def test_a_robot_whose_wifi_drops_is_reported_disconnected() -> None:
+    handler = Recorder()
+    with serving(handler) as server, firmware(server) as robot_fw:
+        assert wait_until(lambda: handler.connected)
+        robot_fw._close()  # the link goes away
+        assert wait_until(lambda: handler.disconnected)
+        robot, reason = handler.disconnected[0]
+        assert reason == "the robot closed the connection" and not robot.connected
+        assert server.robots() == []
