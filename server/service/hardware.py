@@ -13,6 +13,7 @@ message to the link's inbox (bounded: latest values win when a run is not readin
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import threading
 import time
@@ -96,6 +97,13 @@ class HardwareHub(RosserialHandler):
     def stop(self) -> None:
         if self.server is not None:
             self.server.stop()
+        with self._lock:
+            links = list(self._links.values())
+        for link in links:
+            close = getattr(link, "close", None)  # serial links own their port
+            if close is not None:
+                with contextlib.suppress(Exception):
+                    close()
 
     @property
     def port(self) -> int | None:
@@ -158,10 +166,41 @@ class HardwareHub(RosserialHandler):
         return self._links.get(name) if name else None
 
     # ------------------------------------------------------------------ the service's side
-    def link(self, name: str) -> RosserialLink | None:
+    def link(self, name: str):
+        """A connected robot by inventory name: a rosserial robot that connected to us, or a
+        serial (Create/Roomba) base opened now; None (and a problem noted) otherwise."""
         with self._lock:
             link = self._links.get(name)
-        return link if link is not None and link.connected else None
+        if link is not None and link.connected:
+            return link
+        with self.store.session() as db:
+            entry = inventory.by_name(db, name)
+            serial = entry is not None and entry.transport == "create_oi"
+            port, baud = (entry.address, entry.baud) if serial else (None, None)
+        if not serial:
+            return None
+        return self._open_serial(name, port, baud)
+
+    def _open_serial(self, name: str, port: str, baud: int | None):
+        from server.hardware.create.link import CreateLink
+        from server.hardware.create.port import CreateError
+
+        link = CreateLink(port, baud)
+        try:
+            link.open()
+        except (CreateError, OSError, ValueError) as error:
+            with self._lock:
+                self._problems[name] = [f"{name}: {error}"]
+            log.warning("hardware: %s: %s", name, error)
+            return None
+        with self._lock:
+            old = self._links.get(name)
+            self._links[name] = link
+            self._problems[name] = []
+        if old is not None:
+            with contextlib.suppress(Exception):
+                old.close()
+        return link
 
     def queue(self, name: str) -> RobotQueue:
         with self._lock:
@@ -171,7 +210,9 @@ class HardwareHub(RosserialHandler):
             return queue
 
     def connection_state(self, name: str) -> str:
-        if self.link(name) is not None:
+        with self._lock:
+            link = self._links.get(name)
+        if link is not None and link.connected:
             problems = self._problems.get(name) or []
             return (
                 "connected" if not problems else "connected with problems: " + "; ".join(problems)

@@ -156,3 +156,50 @@ def test_a_robot_that_disconnects_ends_its_run(bench):
     firmware._close()  # the robot's WiFi drops
     run = wait_for_end(student, run_id, timeout_s=20)
     assert run["state"] == "failed" and run["reason"] == "failed: robot disconnected"
+
+
+CREATE_DRIVER = """\
+RATE_HZ = 10
+SUBSCRIBE = ["odom"]
+
+
+def step(obs):
+    return {"cmd_vel": (0.15, 0.0)}
+"""
+
+
+def test_a_create_base_on_a_serial_port_is_driven_through_the_same_api(bench):
+    from tests.hardware.create_emulator import CreateEmulator
+
+    server, _ = bench
+    with CreateEmulator() as emulator:
+        admin = server.admin()
+        made = admin.post(
+            "/api/admin/robots",
+            json={"name": "roomba-1", "kind": "turtlebot", "address": emulator.port,
+                  "baud": 115200},
+        )  # fmt: skip
+        assert made.status_code == 201, made.text
+        student = server.student("dora")
+        body = {"robot": "turtlebot", "world": "office", "duration": 2,
+                "nodes": [{"name": "drive", "code": CREATE_DRIVER}]}  # fmt: skip
+        simulated = student.post("/api/runs", json=body).json()
+        assert wait_for_end(student, simulated["id"])["state"] == "finished"
+        student.post("/api/hardware/roomba-1/queue")
+        started = student.post("/api/runs", json={**body, "hardware": "roomba-1"})
+        assert started.status_code == 201, started.text
+        run = wait_for_end(student, started.json()["id"], timeout_s=30)
+        assert run["state"] == "finished", run["reason"]
+        x, _, _ = emulator.pose()
+        assert 0.1 < x < 0.35  # ~0.15 m/s for 2 s, ramped from rest
+        assert emulator.commands(emulator_opcode("DRIVE_DIRECT"))[-1] == bytes(4)  # zero at end
+        recording = student.get(f"/api/runs/{run['id']}/recording.mcap").content
+        topics = {c.topic for _, c, _ in make_reader(io.BytesIO(recording)).iter_messages()}
+        assert {"/odom", "/bumper", "/cmd_vel"} <= topics
+        admin.delete("/api/admin/robots/roomba-1")
+
+
+def emulator_opcode(name: str):
+    from server.hardware.create import oi
+
+    return oi.Opcode[name]
