@@ -8,7 +8,7 @@ shared/notes/protocols.md)::
     len_chk = 255 - (len_lo + len_hi) % 256
     chk     = 255 - (id_lo + id_hi + sum(payload)) % 256
 
-FF is the sync flag, FE the protocol version, the length counts payload bytes only.
+FF is the sync flag; the length counts payload bytes only.
 
 The second byte is the protocol version: 0xFE since rosserial 0.5 (ROS Hydro); 0xFF was
 rosserial 0.4 and earlier (Groovy). Topic ids below 100 are reserved (``TopicId``); a device
