@@ -76,6 +76,7 @@ def create_app(settings: Settings | None = None, launcher: Launcher | None = Non
         app.state.hardware = HardwareHub(store, settings)
         app.state.hardware.start()
         app.state.runs = RunService(store, settings, run_launcher, app.state.hardware)
+        app.state.hardware.runs = app.state.runs
         url = bootstrap(store, settings)
         if url:
             print(f"RoboDojo: log in as the instructor at {url}", flush=True)

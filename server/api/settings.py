@@ -36,6 +36,8 @@ class Settings(BaseSettings):
     rosserial_port: int = Field(11411, ge=-1, le=65535)
     rosserial_host: str = "0.0.0.0"
     hardware_gate: bool = True  # a hardware run needs the same code to have passed in simulation
+    hardware_slot_s: float = Field(300.0, gt=0)  # [s] longest turn on a robot
+    hardware_start_within_s: float = Field(60.0, gt=0)  # [s] a turn not started passes on
 
     unsafe_no_sandbox: bool = False  # trusted machines only: student code runs unconfined
     sandbox_pool: int = Field(2, ge=0)  # warm sandbox processes kept ready

@@ -27,6 +27,7 @@ from server.store import robots as inventory
 from server.store.db import Store
 
 log = logging.getLogger("robodojo.hardware")
+QUEUE_TICK_S = 1.0  # [s] slots not started in time pass on, runs past their slot stop
 INBOX_MAX = 1000  # messages waiting for a run: ~10 s of the CrowBot's topics; older ones go
 LOG_LINES_KEPT = 200  # per robot, for the instructor
 
@@ -77,9 +78,13 @@ class HardwareHub(RosserialHandler):
         self._lock = threading.Lock()
         self.server: RosserialServer | None = None
         self.listen_error = ""
+        self.runs = None  # the RunService, set by the app: the queue stops runs past their slot
+        self._closing = threading.Event()
+        self._ticker = threading.Thread(target=self._tick_queues, name="robot-queues", daemon=True)
 
     # ------------------------------------------------------------------ lifecycle
     def start(self) -> None:
+        self._ticker.start()
         port = self.settings.rosserial_port
         if port is None or port < 0:
             self.listen_error = "rosserial is switched off (--rosserial-port -1)"
@@ -94,7 +99,17 @@ class HardwareHub(RosserialHandler):
         self.server = server
         log.info("rosserial: CrowBots connect to port %d", server.port)
 
+    def _tick_queues(self) -> None:
+        while not self._closing.wait(QUEUE_TICK_S):
+            with self._lock:
+                queues = list(self._queues.values())
+            for queue in queues:
+                for run_id in queue.tick(time.monotonic()):
+                    if self.runs is not None:
+                        self.runs.stop(run_id, "the robot's time slot is over")
+
     def stop(self) -> None:
+        self._closing.set()
         if self.server is not None:
             self.server.stop()
         with self._lock:
@@ -206,7 +221,11 @@ class HardwareHub(RosserialHandler):
         with self._lock:
             queue = self._queues.get(name)
             if queue is None:
-                queue = self._queues[name] = RobotQueue(name)
+                queue = self._queues[name] = RobotQueue(
+                    name,
+                    slot_s=self.settings.hardware_slot_s,
+                    start_within_s=self.settings.hardware_start_within_s,
+                )
             return queue
 
     def connection_state(self, name: str) -> str:

@@ -203,3 +203,29 @@ def emulator_opcode(name: str):
     from server.hardware.create import oi
 
     return oi.Opcode[name]
+
+
+def test_a_turn_on_the_robot_ends_when_its_slot_is_over(tmp_path):
+    server = start_server(tmp_path, {"ROBODOJO_HARDWARE_SLOT_S": "2",
+                                     "ROBODOJO_HARDWARE_GATE": "false"})  # fmt: skip
+    try:
+        admin = server.admin()
+        port = admin.get("/api/admin/status").json()["hardware"]["rosserial_port"]
+        robot = {"name": "crowbot-9", "kind": "crowbot", "address": "127.0.0.1"}
+        assert admin.post("/api/admin/robots", json=robot).status_code == 201
+        with CrowBotFirmware("127.0.0.1", port) as firmware:
+            assert firmware.wait_until(lambda: firmware.configured, 10)
+            time.sleep(0.5)
+            student = server.student("eve")
+            student.post("/api/hardware/crowbot-9/queue")
+            started = student.post(
+                "/api/runs",
+                json={"robot": "crowbot", "world": "wall_approach", "hardware": "crowbot-9",
+                      "duration": 30, "nodes": [{"name": "approach", "code": ROSPY}]},
+            )  # fmt: skip
+            assert started.status_code == 201, started.text  # no gate on this server
+            run = wait_for_end(student, started.json()["id"], timeout_s=20)
+        assert run["state"] == "interrupted"
+        assert "time slot is over" in run["reason"] and run["time_s"] < 5
+    finally:
+        stop_server(server)
