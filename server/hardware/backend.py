@@ -163,10 +163,13 @@ class HardwareRobot:
         """Zero velocity and LEDs off: every end of a run (the link may already be gone)."""
         if not self.link.connected:
             return
-        self._send_zero()
-        if LEDS_TOPIC in self.robot.commands:
-            msg_type = self.robot.commands[LEDS_TOPIC][0]
-            self.link.send(LEDS_TOPIC, msg_type(data=[0, 0, 0]))
+        try:
+            self._send_zero()
+            if LEDS_TOPIC in self.robot.commands:
+                msg_type = self.robot.commands[LEDS_TOPIC][0]
+                self.link.send(LEDS_TOPIC, msg_type(data=[0, 0, 0]))
+        except RobotLost:  # gone in between: nothing left to stop
+            pass
 
     def _send_zero(self) -> None:
         for topic in self._velocity_topics:

@@ -38,14 +38,26 @@ class RosserialLink:
     def __init__(self, connection: RobotConnection, name: str) -> None:
         self.connection = connection
         self.name = name
-        self.connected = True
+        self._lost = False
         self.lost_reason = ""
         self._inbox: deque[tuple[str, object, float]] = deque(maxlen=INBOX_MAX)
         self._lock = threading.Lock()
         self.logs: deque[str] = deque(maxlen=LOG_LINES_KEPT)
 
+    @property
+    def connected(self) -> bool:
+        # The session closes before the hub hears of it: ask the connection itself.
+        return not self._lost and self.connection.connected
+
     def send(self, topic: str, message: object) -> None:
-        self.connection.send(topic, message)
+        from server.hardware.backend import RobotLost
+        from server.hardware.rosserial.session import RobotDisconnected
+
+        try:
+            self.connection.send(topic, message)
+        except RobotDisconnected:
+            self.lose("robot disconnected")
+            raise RobotLost("robot disconnected") from None
 
     def take_received(self) -> list[tuple[str, object, float]]:
         with self._lock:
@@ -64,7 +76,7 @@ class RosserialLink:
 
     def lose(self, reason: str) -> None:
         self.lost_reason = reason
-        self.connected = False
+        self._lost = True
 
 
 class HardwareHub(RosserialHandler):
