@@ -159,6 +159,11 @@ class HardwareRobot:
             self._send_zero()
         return published
 
+    def take_logs(self) -> list[str]:
+        """What the robot logged (rosserial id 7) since the last call, for the run's log."""
+        take = getattr(self.link, "take_logs", None)
+        return take() if take is not None else []
+
     def stop(self) -> None:
         """Zero velocity and LEDs off: every end of a run (the link may already be gone)."""
         if not self.link.connected:

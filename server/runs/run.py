@@ -449,6 +449,8 @@ class Run(RunControls):
             self._apply_control(action, value)
         if self.builtins:
             self.builtins.tick(self)
+        if self.backend is not None:
+            self._robot_logs()
         self._check_robot()
         if self.time_ns >= self._next_tf_ns:
             self._record_tf()
@@ -482,6 +484,19 @@ class Run(RunControls):
         )
         self.record("tf", message._type, self.time_ns, message.serialize())
         self._next_tf_ns = self.time_ns + TF_PERIOD_NS
+
+    def _robot_logs(self) -> None:
+        """A real robot's own log lines (rosserial loginfo) go into the run's log as node
+        'robot', beside the students' nodes."""
+        lines = self.backend.take_logs()
+        if not lines:
+            return
+        self.recorder.write_log("robot", lines)
+        if self.observer is not None:
+            try:
+                self.observer.on_logs("robot", lines)
+            except Exception:
+                log.exception("run %s: the observer failed on robot log lines", self.run_id)
 
     def record(self, topic: str, type_name: str, time_ns: int, data: bytes) -> None:
         """One message into the recording and, if someone watches, to the observer."""

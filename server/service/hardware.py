@@ -42,7 +42,8 @@ class RosserialLink:
         self.lost_reason = ""
         self._inbox: deque[tuple[str, object, float]] = deque(maxlen=INBOX_MAX)
         self._lock = threading.Lock()
-        self.logs: deque[str] = deque(maxlen=LOG_LINES_KEPT)
+        self.logs: deque[str] = deque(maxlen=LOG_LINES_KEPT)  # the instructor's view
+        self._new_logs: deque[str] = deque(maxlen=LOG_LINES_KEPT)  # for the run on the robot
 
     @property
     def connected(self) -> bool:
@@ -69,6 +70,16 @@ class RosserialLink:
         """Forget what arrived before a run started."""
         with self._lock:
             self._inbox.clear()
+
+    def log(self, line: str) -> None:
+        self.logs.append(line)
+        self._new_logs.append(line)
+
+    def take_logs(self) -> list[str]:
+        with self._lock:
+            taken = list(self._new_logs)
+            self._new_logs.clear()
+        return taken
 
     def push(self, topic: str, message: object) -> None:
         with self._lock:
@@ -186,7 +197,7 @@ class HardwareHub(RosserialHandler):
     def on_log(self, robot: RobotConnection, level: LogLevel, line: str) -> None:
         link = self._link_of(robot)
         if link is not None:
-            link.logs.append(f"[{level.name.lower()}] {line}")
+            link.log(f"[{level.name.lower()}] {line}")
 
     def _link_of(self, robot: RobotConnection) -> RosserialLink | None:
         name = self._by_connection.get(robot.id)

@@ -13,7 +13,7 @@ import pytest
 from mcap.reader import make_reader
 
 from tests.api.conftest import LabServer, start_server, stop_server, wait_for_end
-from tests.hardware.crowbot_firmware import CrowBotFirmware
+from tests.hardware.crowbot_firmware import CrowBotFirmware, FirmwareOptions
 
 ROSPY = """\
 import rospy
@@ -43,7 +43,7 @@ def bench(tmp_path_factory) -> Iterator[tuple[LabServer, CrowBotFirmware]]:
         "/api/admin/robots", json={"name": "crowbot-1", "kind": "crowbot", "address": "127.0.0.1"}
     )
     assert made.status_code == 201, made.text
-    firmware = CrowBotFirmware("127.0.0.1", port).start()
+    firmware = CrowBotFirmware("127.0.0.1", port, FirmwareOptions(log_commands=True)).start()
     assert firmware.wait_until(lambda: firmware.configured, 10), "the firmware did not negotiate"
     deadline = time.monotonic() + 10
     while admin.get("/api/admin/robots").json()["robots"][0]["connection"] != "connected":
@@ -113,6 +113,8 @@ def test_code_that_passed_in_simulation_drives_the_real_robot(bench):
     for _, channel, _message in make_reader(io.BytesIO(recording)).iter_messages():
         topics[channel.topic] = topics.get(channel.topic, 0) + 1
     assert topics["/Distance"] >= 40 and topics["/Control"] >= 15  # the robot's own readings
+    robot_log = student.get(f"/api/runs/{run['id']}/logs").json()["nodes"]["robot"]
+    assert robot_log and robot_log[0].startswith("[info]")  # the firmware's nh.loginfo lines
     # The slot is given back: the queue is empty again.
     assert student.get("/api/hardware").json()["robots"][0]["queue"]["places"] == []
 
@@ -229,3 +231,22 @@ def test_a_turn_on_the_robot_ends_when_its_slot_is_over(tmp_path):
         assert "time slot is over" in run["reason"] and run["time_s"] < 5
     finally:
         stop_server(server)
+
+
+def test_out_of_service_holds_the_queue_and_refuses_runs(bench):
+    server, _ = bench
+    admin = server.admin()
+    first, second = server.student("fay"), server.student("gus")
+    assert first.post("/api/hardware/crowbot-1/queue").json()["state"] == "offered"
+    second.post("/api/hardware/crowbot-1/queue")
+    assert admin.patch("/api/admin/robots/crowbot-1", json={"in_service": False}).is_success
+    places = admin.get("/api/hardware").json()["robots"][0]["queue"]["places"]
+    assert [p["state"] for p in places] == ["waiting", "waiting"]  # nobody lost a place
+    refused = first.post("/api/hardware/crowbot-1/queue")
+    assert refused.status_code == 409 and "out of service" in refused.json()["detail"]
+    assert admin.patch("/api/admin/robots/crowbot-1", json={"in_service": True}).is_success
+    mine = first.get("/api/hardware").json()["robots"][0]
+    assert mine["my_position"] == 1 and mine["queue"]["places"][0]["state"] == "offered"
+    assert "user_id" not in mine["queue"]["places"][0]  # students see places, not names
+    first.delete("/api/hardware/crowbot-1/queue")
+    second.delete("/api/hardware/crowbot-1/queue")

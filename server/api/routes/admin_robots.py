@@ -4,6 +4,7 @@ limits), list them with their connection state, take one out of service, remove 
 from __future__ import annotations
 
 import math
+import time
 from typing import Literal
 
 from fastapi import APIRouter, Depends, HTTPException, Request
@@ -117,7 +118,11 @@ def update_robot(name: str, body: RobotUpdate, request: Request) -> dict:
     with request.app.state.store.session() as db:
         entry = _entry(db, name)
         entry.in_service = body.in_service
-        return robot_out(entry, request)
+        out = robot_out(entry, request)
+    # Out of service: an offered turn waits, nobody loses their place; back: the next is offered.
+    request.app.state.hardware.queue(name).set_in_service(body.in_service, time.monotonic())
+    out["in_service"] = body.in_service
+    return out
 
 
 @router.delete("/{name}", summary="Remove a robot from the inventory")
