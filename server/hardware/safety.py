@@ -51,7 +51,12 @@ def _clamp(value: float, limit: float) -> float:
 
 
 def _ramp(current: float, target: float, max_step: float) -> float:
-    return current + _clamp(target - current, max_step)
+    """Toward `target` by at most `max_step`; exactly `target` once within reach (adding the
+    difference back could land a rounding error past a limit: 0.30000000000000004 m/s)."""
+    step = target - current
+    if abs(step) <= max_step:
+        return target
+    return current + math.copysign(max_step, step)
 
 
 class VelocityLimiter:
