@@ -1,5 +1,6 @@
 // Run controls and the run on show: start a run in simulation (clock, duration, seed; in free
-// play optionally with the teleop node, "Drive with arrow keys"), stop,
+// play optionally with the teleop node, "Drive with arrow keys") or on a bench robot
+// (startOnRobot: realtime, the hardware panel's "Run on the real robot"), stop,
 // pause/resume (lockstep only), the progress of simulated time, the state and why it ended,
 // and the checks. A live run is followed over its websocket and its record polled for the
 // figures the websocket does not carry (node periods, time).
@@ -42,9 +43,6 @@ export function initRunner() {
   });
   stopButton.addEventListener("click", () => command("stop"));
   pauseButton.addEventListener("click", () => command(state === "paused" ? "resume" : "pause"));
-  byId("real-robot-button").addEventListener("click", () => {
-    say("The lab's real robots are not connected yet: run in simulation for now.");
-  });
   teleopInput.checked = localStorage.getItem(TELEOP_KEY) === "true";
   teleopInput.addEventListener("change", () => localStorage.setItem(TELEOP_KEY, String(teleopInput.checked)));
   on("target", ({ target }) => {
@@ -57,9 +55,35 @@ export function initRunner() {
   controls();
 }
 
+/** Whether a run on show is going (a new one cannot start meanwhile). */
+export function runGoing() {
+  return starting || (Boolean(app.live) && !END_STATES.has(state));
+}
+
+/** The body of POST /api/runs for the editor's nodes and the target. */
+function runBody() {
+  const target = app.target;
+  const body = target.exercise ? { exercise: target.exercise.id } : { robot: target.robot, world: target.world };
+  body.nodes = nodes();
+  body.clock = clockInput.value;
+  body.duration = Number(durationInput.value);
+  if (seedInput.value !== "") body.seed = Number(seedInput.value);
+  if (!target.exercise && teleopInput.checked) body.teleop = true;
+  return body;
+}
+
+async function post(body) {
+  flushAll(); // the run gets the code in the request; the workspace keeps it too
+  const run = await api("/api/runs", { method: "POST", body });
+  if (body.teleop) app.teleopRuns.add(run.id);
+  showRun(run);
+  if (body.teleop) emit("drive"); // the World tab, its pad focused: the arrow keys drive
+  return run;
+}
+
 /** Start a run of the editor's nodes for the target. */
 export async function start() {
-  if (starting || (app.live && !END_STATES.has(state))) return;
+  if (runGoing()) return;
   if (app.watching) {
     say("This is a run opened by its id, with its code read only: go back to your code to run.");
     return;
@@ -68,21 +92,32 @@ export async function start() {
   starting = true;
   controls();
   say("");
-  const target = app.target;
-  const body = target.exercise ? { exercise: target.exercise.id } : { robot: target.robot, world: target.world };
-  body.nodes = nodes();
-  body.clock = clockInput.value;
-  body.duration = Number(durationInput.value);
-  if (seedInput.value !== "") body.seed = Number(seedInput.value);
-  if (!target.exercise && teleopInput.checked) body.teleop = true;
-  flushAll(); // the run gets the code in the request; the workspace keeps it too
   try {
-    const run = await api("/api/runs", { method: "POST", body });
-    if (body.teleop) app.teleopRuns.add(run.id);
-    showRun(run);
-    if (body.teleop) emit("drive"); // the World tab, its pad focused: the arrow keys drive
+    await post(runBody());
   } catch (error) {
     say(error.message); // the server's sentence, verbatim
+  } finally {
+    starting = false;
+    controls();
+  }
+}
+
+/** Start the editor's nodes on the bench robot `name` (realtime; the server checks the turn and
+ * the simulation gate). Resolves with the run; rejects with the ApiError (its body carries the
+ * gate verdict of a 409), which the caller shows. */
+export async function startOnRobot(name) {
+  if (runGoing()) throw new Error("a run is going: stop it first");
+  if (app.watching) throw new Error("this is a run opened by its id: go back to your code to run");
+  if (!durationInput.reportValidity()) throw new Error("give the run a duration first");
+  starting = true;
+  controls();
+  say("");
+  try {
+    const body = runBody();
+    body.hardware = name;
+    body.clock = "realtime"; // a real robot lives in real time
+    delete body.seed; // the world is the real one
+    return await post(body);
   } finally {
     starting = false;
     controls();
@@ -245,6 +280,7 @@ function progressOf(run) {
 
 function controls() {
   const active = Boolean(app.live) && !END_STATES.has(state);
+  emit("run-controls", { going: starting || active });
   runButton.disabled = starting || active || Boolean(app.watching);
   runButton.textContent = starting ? "Starting…" : "▶ Run in simulation";
   stopButton.disabled = !active;

@@ -11,6 +11,7 @@
 //   run-state  {state, reason, time_s}
 //   run-topic  {topic, msg_type}   a topic of the live run seen for the first time
 //   run-ended  {run}               the run on show has ended and its record (checks) is stored
+//   run-controls {going}           the run controls were redrawn: a run is starting or going
 //   goto-line  {node, line}        show this line of this node's file in the editor
 //   run-graph  {run, graph}        the node/topic graph of the run on show (its built-in nodes)
 //   drive      {}                  a run to drive with the arrow keys started: show the pad

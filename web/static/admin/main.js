@@ -5,6 +5,7 @@ import { ApiError, get, onUnauthorized, post } from "./api.js";
 import { $, $$, copyText, h } from "./dom.js";
 import { initCourses, showCourses } from "./courses.js";
 import { initExercises, showExercises } from "./exercises.js";
+import { initHardware, showHardware } from "./hardware.js";
 import { initRuns, showRuns } from "./runs.js";
 import { loadCourses, loadExercises, loadUsers, state } from "./state.js";
 import { startStatus, stopStatus, refreshStatus } from "./status.js";
@@ -15,7 +16,7 @@ const SECTIONS = {
   users: showUsers,
   exercises: showExercises,
   courses: showCourses,
-  hardware: () => {},
+  hardware: () => showHardware(true),
   status: refreshStatus,
 };
 let current = null;
@@ -25,6 +26,7 @@ function gate(...content) {
   $("#nav").hidden = true;
   $("#who").hidden = !state.me;
   showRuns(false);
+  showHardware(false);
   stopStatus();
   current = null;
   const box = $("#gate");
@@ -108,6 +110,7 @@ function show(name, initial) {
       else link.removeAttribute("aria-current");
     }
     if (current === "runs") showRuns(false);
+    if (current === "hardware") showHardware(false);
     current = name;
     document.title = `RoboDojo · ${$(`#section-${name} h1`).textContent} · Instructor console`;
     if (!initial) {
@@ -138,6 +141,7 @@ async function start() {
   initRuns();
   initExercises();
   initCourses();
+  initHardware();
 
   let me;
   try {

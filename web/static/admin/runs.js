@@ -1,6 +1,7 @@
 // Runs: everyone's live runs (polled every 2 s, rows updated in place so keyboard focus stays
-// on a Stop button), and the recent runs with filters and paging. Watch opens the student
-// page on the run; 3D opens the viser view.
+// on a Stop button; each has an emergency stop too: a real robot stops at once), and the
+// recent runs with filters and paging. Watch opens the student page on the run; 3D opens the
+// viser view.
 
 import { enc, get, post } from "./api.js";
 import {
@@ -46,14 +47,16 @@ function who(run) {
 
 function what(run) {
   const place = `${run.robot} in ${run.world}`;
-  if (!run.exercise) return h("span", {}, place);
+  const bench = run.hardware ? h("span", { className: "hw-badge", title: "a run on a real robot of the bench" }, `real robot ${run.hardware}`) : null;
+  if (!run.exercise) return h("span", {}, place, bench ? [" ", bench] : null);
   const title = exerciseTitle(run.exercise);
   return h(
     "span",
     {},
     h("span", { title: run.exercise }, title || run.exercise),
     h("br"),
-    h("span", { className: "muted small" }, place),
+    h("span", { className: "muted small" }, run.hardware ? run.robot : place),
+    bench ? [" ", bench] : null,
   );
 }
 
@@ -102,6 +105,36 @@ function stopButton(run, cell, after) {
   return button;
 }
 
+function estopButton(run, cell, after) {
+  const button = h(
+    "button",
+    {
+      type: "button",
+      className: "estop small-btn",
+      "data-testid": "run-estop",
+      dataset: { runId: run.id, action: "estop" },
+      "aria-label": `Emergency stop of run ${shortId(run.id)}${run.hardware ? ` on ${run.hardware}` : ""}`,
+      title: run.hardware ? `Stops ${run.hardware} now` : "Stops the run now",
+    },
+    "E-stop",
+  );
+  button.addEventListener("click", () => {
+    if (button.dataset.done) return;
+    busy(button, async () => {
+      clearRowError(cell);
+      try {
+        await post(`/api/runs/${enc(run.id)}/estop`);
+        button.dataset.done = "1"; // stays focusable (and aria-disabled) until its row goes
+        button.textContent = "Stopped";
+        after?.();
+      } catch (error) {
+        rowError(cell, error);
+      }
+    });
+  });
+  return button;
+}
+
 function progress(run) {
   const time = Number(run.time_s) || 0;
   const total = Number(run.duration_s) || 0;
@@ -119,7 +152,7 @@ function liveRow(run) {
     time: h("td", { className: "nowrap" }, progress(run)),
     actions,
   };
-  actions.append(...links(run), " ", stopButton(run, actions, pollLive));
+  actions.append(...links(run), " ", stopButton(run, actions, pollLive), " ", estopButton(run, actions, pollLive));
   const row = h(
     "tr",
     { dataset: { runId: run.id } },

@@ -18,6 +18,17 @@ function card(title, value, ...lines) {
   );
 }
 
+function hardwareCard(hw) {
+  if (!hw) return null;
+  const problems = Object.values(hw.problems || {}).reduce((n, lines) => n + lines.length, 0);
+  return card(
+    "Hardware",
+    hw.rosserial_port ? `port ${hw.rosserial_port}` : "off",
+    `rosserial listening: ${hw.listening ?? "?"}`,
+    problems ? `${problems} problem${problems === 1 ? "" : "s"}: see Hardware` : "no problems",
+  );
+}
+
 function render(s) {
   const runs = s.runs || {};
   const byState = Object.entries(runs.active_by_state || {})
@@ -27,7 +38,7 @@ function render(s) {
   const server = s.server || {};
   const sandbox = s.sandbox || {};
   const load = (machine.load_average || []).map((x) => x.toFixed(2)).join(" / ");
-  $("#status-cards").replaceChildren(
+  const cards = [
     card(
       "Active runs",
       String(runs.active_runs ?? "–"),
@@ -53,13 +64,15 @@ function render(s) {
       `${machine.memory_available_mib ?? "?"} MiB available`,
       `server process: ${server.rss_mib ?? "?"} MiB resident`,
     ),
+    hardwareCard(s.hardware),
     card(
       "Server",
       `up ${seconds(s.uptime_s)}`,
       `database: ${s.database ?? "?"}`,
       s.queues ? `waiting runs: ${s.queues.waiting_runs}; ${s.queues.note || ""}` : null,
     ),
-  );
+  ];
+  $("#status-cards").replaceChildren(...cards.filter(Boolean));
   $("#status-updated").textContent = `Updated ${new Date().toLocaleTimeString()}; every ${POLL_MS / 1000} s.`;
   const loadNow = machine.load_average ? machine.load_average[0].toFixed(1) : "?";
   $("#status-summary").textContent = `${runs.active_runs ?? 0} active run${runs.active_runs === 1 ? "" : "s"} · load ${loadNow}/${machine.cpus ?? "?"} · mem ${machine.memory_used_percent ?? "?"} %`;
