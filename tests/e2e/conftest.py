@@ -34,8 +34,10 @@ SCREENSHOTS = Path(
 )  # fmt: skip
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture(scope="module")
 def browser():
+    """Per module, not per session: Playwright's sync API keeps an asyncio loop running on this
+    thread while it is open, and later tests that call asyncio.run() would find it."""
     from playwright.sync_api import sync_playwright
 
     if not Path(CHROMIUM).exists():
