@@ -381,7 +381,11 @@ class CrowBotFirmware:
             sock = self._sock
             if sock is None:
                 return
-            readable, _, _ = select.select([sock], [], [], max(0.0, next_tick - time.monotonic()))
+            try:
+                timeout_s = max(0.0, next_tick - time.monotonic())
+                readable, _, _ = select.select([sock], [], [], timeout_s)
+            except (OSError, ValueError):  # closed by another thread (a test dropping the WiFi)
+                readable = [sock]
             if readable:
                 try:
                     data = sock.recv(4096)
