@@ -31,7 +31,7 @@ class Caller:
         return self.role is Role.INSTRUCTOR
 
 
-def _bearer(header: str | None) -> str | None:
+def bearer_token(header: str | None) -> str | None:
     if not header:
         return None
     scheme, _, token = header.partition(" ")
@@ -61,7 +61,7 @@ def current_user(request: Request) -> Caller:
     caller = resolve(
         store,
         request.cookies.get(SESSION_COOKIE),
-        _bearer(request.headers.get("authorization")),
+        bearer_token(request.headers.get("authorization")),
     )
     if caller is None:
         raise HTTPException(
@@ -79,7 +79,8 @@ def instructor(caller: Caller = Depends(current_user)) -> Caller:
 
 def websocket_user(websocket: WebSocket) -> Caller | None:
     store: Store = websocket.app.state.store
-    token = _bearer(websocket.headers.get("authorization")) or websocket.query_params.get("token")
+    header = websocket.headers.get("authorization")
+    token = bearer_token(header) or websocket.query_params.get("token")
     return resolve(store, websocket.cookies.get(SESSION_COOKIE), token)
 
 

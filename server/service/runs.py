@@ -9,7 +9,9 @@ never raises for what a node does, and anything else is caught here and stored a
 
 from __future__ import annotations
 
+import dataclasses
 import logging
+import math
 import threading
 import time
 import uuid
@@ -20,12 +22,16 @@ from pathlib import Path
 from sandbox.launcher import Launcher
 from sandbox.protocol import Clock
 from server.exercises.grading import judge_run, run_spec
+from server.hardware.backend import HardwareRobot
+from server.hardware.queue import QueueError
+from server.hardware.safety import MotionLimits
 from server.runs.result import RunResult
 from server.runs.run import Run
 from server.runs.spec import NodeSpec, RunSpec
 from server.runs.state import RunState
 from server.service.catalog import ExerciseEntry
 from server.service.telemetry import RunTelemetry, TelemetryRegistry
+from server.store import robots as inventory
 from server.store import runs as run_store
 from server.store.db import Store
 from server.store.models import RunRecord
@@ -223,11 +229,6 @@ class RunService:
 
     def _claim_robot(self, name: str, user_id: str, run_id: str, spec: RunSpec):
         """The bench robot for this run, if it is the user's turn (raises with a sentence)."""
-        from server.hardware.backend import HardwareRobot
-        from server.hardware.queue import QueueError
-        from server.hardware.safety import MotionLimits
-        from server.store import robots as inventory
-
         if self.hardware is None:
             raise RunRequestError("this server has no hardware support switched on")
         with self.store.session() as db:
@@ -370,9 +371,7 @@ class RunService:
 
 
 def _replace(spec: RunSpec, **changes) -> RunSpec:
-    from dataclasses import replace
-
-    return replace(spec, **changes)
+    return dataclasses.replace(spec, **changes)
 
 
 def _count(values) -> dict[str, int]:
@@ -384,8 +383,6 @@ def _count(values) -> dict[str, int]:
 
 def _finite(value):
     """JSON columns take no NaN/inf (PostgreSQL refuses them): None stands for 'no value'."""
-    import math
-
     if isinstance(value, float):
         return value if math.isfinite(value) else None
     if isinstance(value, dict):

@@ -5,10 +5,17 @@ from __future__ import annotations
 
 import html
 
-from fastapi import APIRouter, Depends, Request, Response
+from fastapi import APIRouter, Depends, HTTPException, Request, Response
 from fastapi.responses import HTMLResponse, RedirectResponse
 
-from server.api.auth import SESSION_COOKIE, Caller, current_user, secure_request
+from server.api.auth import (
+    SESSION_COOKIE,
+    Caller,
+    bearer_token,
+    current_user,
+    resolve,
+    secure_request,
+)
 from server.api.schemas import SessionCreate
 from server.store import accounts
 from server.store.accounts import SESSION_LIFETIME_S
@@ -64,8 +71,6 @@ def login_link(request: Request, token: str = "") -> Response:
 def login(body: SessionCreate, request: Request, response: Response) -> dict:
     session_token = _login(request, body.token)
     if session_token is None:
-        from fastapi import HTTPException
-
         raise HTTPException(401, BAD_TOKEN)
     _set_cookie(response, request, session_token)
     return {"ok": True}
@@ -83,13 +88,10 @@ def logout(request: Request, response: Response) -> dict:
 
 @router.get("/api/session", summary="Who is logged in, if anyone (never 401: for pages)")
 def session_state(request: Request) -> dict:
-    from server.api.auth import SESSION_COOKIE as COOKIE
-    from server.api.auth import _bearer, resolve
-
     caller = resolve(
         request.app.state.store,
-        request.cookies.get(COOKIE),
-        _bearer(request.headers.get("authorization")),
+        request.cookies.get(SESSION_COOKIE),
+        bearer_token(request.headers.get("authorization")),
     )
     if caller is None:
         return {"user": None}
