@@ -35,6 +35,8 @@ def cmd_serve(args: argparse.Namespace) -> int:
 
     settings = _settings(args)
     logging.basicConfig(level=logging.INFO, format="%(levelname)s %(name)s: %(message)s")
+    # Alembic names each of its plugins at INFO: noise on every start. Migrations still show.
+    logging.getLogger("alembic.runtime.plugins").setLevel(logging.WARNING)
     # Fail before uvicorn starts, with our sentence, when the database or sandbox cannot work.
     Store.open(settings.store_url).close()
     launcher = Launcher(
