@@ -81,6 +81,9 @@ class Exercise:
     script: tuple[ScriptEvent, ...] = ()
     builtin_nodes: tuple[str, ...] = ()  # trusted helpers (server/runs/builtin.py)
     params: dict[str, object] = field(default_factory=dict)
+    # Before a run on a real robot, this code must have finished a simulation run of this
+    # exercise (server setting ROBODOJO_HARDWARE_GATE switches it off for the whole lab).
+    hardware_gate: bool = True
 
     def code_path(self, relative: str) -> Path:
         return EXERCISE_DIR / relative

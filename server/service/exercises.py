@@ -104,6 +104,7 @@ def build(definition: dict) -> ExerciseEntry:
         )
         exercise = dataclasses.replace(
             base,
+            hardware_gate=bool(definition.get("hardware_gate", base.hardware_gate)),
             id=definition["id"],
             title=definition.get("title") or base.title,
             description=definition.get("description") or base.description,
@@ -136,6 +137,7 @@ def build(definition: dict) -> ExerciseEntry:
         starter=(),
         seeds=tuple(definition.get("seeds") or (1,)),
         clock=Clock(definition.get("clock", "lockstep")),
+        hardware_gate=bool(definition.get("hardware_gate", True)),
     )
     return ExerciseEntry(exercise, starter, custom=True)
 

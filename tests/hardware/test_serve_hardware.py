@@ -158,6 +158,16 @@ def test_a_robot_that_disconnects_ends_its_run(bench):
     firmware._close()  # the robot's WiFi drops
     run = wait_for_end(student, run_id, timeout_s=20)
     assert run["state"] == "failed" and run["reason"] == "failed: robot disconnected"
+    # The robot comes back and rejoins the pool.
+    firmware.stop()
+    firmware._stopping.clear()
+    firmware.start()
+    assert firmware.wait_until(lambda: firmware.configured, 10)
+    admin = server.admin()
+    deadline = time.monotonic() + 10
+    while admin.get("/api/admin/robots").json()["robots"][0]["connection"] != "connected":
+        assert time.monotonic() < deadline, "the robot did not rejoin the pool"
+        time.sleep(0.1)
 
 
 CREATE_DRIVER = """\
@@ -250,3 +260,27 @@ def test_out_of_service_holds_the_queue_and_refuses_runs(bench):
     assert "user_id" not in mine["queue"]["places"][0]  # students see places, not names
     first.delete("/api/hardware/crowbot-1/queue")
     second.delete("/api/hardware/crowbot-1/queue")
+
+
+def test_an_exercise_can_waive_the_simulation_gate(bench):
+    server, _ = bench
+    admin = server.admin()
+    made = admin.post(
+        "/api/admin/exercises",
+        json={"id": "bench_free_drive", "title": "Drive on the bench", "robot": "crowbot",
+              "world": "wall_approach", "duration_s": 2, "hardware_gate": False,
+              "starter": [{"name": "approach", "code": ROSPY}],
+              "checks": [{"name": "collisions", "threshold": 0}]},
+    )  # fmt: skip
+    assert made.status_code == 201, made.text
+    assert made.json()["hardware_gate"] is False
+    student = server.student("hal")
+    student.post("/api/hardware/crowbot-1/queue")
+    started = student.post(
+        "/api/runs",
+        json={"exercise": "bench_free_drive", "hardware": "crowbot-1",
+              "nodes": [{"name": "approach", "code": ROSPY}]},
+    )  # fmt: skip
+    assert started.status_code == 201, started.text  # no simulation run needed first
+    assert wait_for_end(student, started.json()["id"], timeout_s=30)["state"] == "finished"
+    admin.delete("/api/admin/exercises/bench_free_drive")

@@ -63,6 +63,9 @@ class ExerciseFields(Strict):
     seeds: list[SEED] | None = Field(
         None, min_length=1, max_length=MAX_SEEDS, description="without a template"
     )
+    hardware_gate: bool | None = Field(
+        None, description="a real-robot run needs this code to have finished in simulation"
+    )
 
 
 class ExerciseCreate(ExerciseFields):
@@ -85,6 +88,7 @@ def exercise_out(entry: ExerciseEntry, row: CustomExercise | None = None) -> dic
     solution (built-in) or who made it and from what (custom)."""
     out = catalog.describe(entry)
     out["seeds"] = list(entry.exercise.seeds)
+    out["hardware_gate"] = entry.exercise.hardware_gate
     if row is None:
         out["reference"] = _files(entry.exercise.reference, entry.exercise)
     else:

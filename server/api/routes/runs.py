@@ -120,7 +120,10 @@ def create(body: RunCreate, request: Request, caller: Caller = Depends(current_u
             )
         catalog.check_robot(body.robot)
         catalog.check_world(body.world)
-    if body.hardware is not None and request.app.state.settings.hardware_gate:
+    gated = request.app.state.settings.hardware_gate and (
+        entry is None or entry.exercise.hardware_gate
+    )
+    if body.hardware is not None and gated:
         from server.api.routes.hardware import gate_refusal, simulation_gate
 
         robot = entry.exercise.robot if entry else body.robot
