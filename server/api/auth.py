@@ -30,6 +30,10 @@ class Caller:
     def is_instructor(self) -> bool:
         return self.role is Role.INSTRUCTOR
 
+    def can_see(self, owner_id: str) -> bool:
+        """A student sees their own things; an instructor sees everyone's."""
+        return owner_id == self.id or self.is_instructor
+
 
 def bearer_token(header: str | None) -> str | None:
     if not header:

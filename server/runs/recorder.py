@@ -86,14 +86,14 @@ def mcap_topic(name: str) -> str:
     return name if name.startswith("/") else "/" + name
 
 
-def _json_safe(value: Any) -> Any:
+def json_safe(value: Any) -> Any:
     """Non-finite floats become null: JSON has no NaN or Infinity."""
     if isinstance(value, float):
         return value if math.isfinite(value) else None
     if isinstance(value, Mapping):
-        return {str(key): _json_safe(item) for key, item in value.items()}
+        return {str(key): json_safe(item) for key, item in value.items()}
     if isinstance(value, list | tuple):
-        return [_json_safe(item) for item in value]
+        return [json_safe(item) for item in value]
     return value
 
 
@@ -329,7 +329,7 @@ class Recorder:
         target = self.out_dir / f"{stem}.json"
         temporary = self.out_dir / f".{stem}.json.tmp"
         try:
-            text = json.dumps(_json_safe(document), indent=2, allow_nan=False, default=str)
+            text = json.dumps(json_safe(document), indent=2, allow_nan=False, default=str)
             temporary.write_text(text + "\n", encoding="utf-8")
             os.replace(temporary, target)
         except Exception as error:  # a recorder never raises a write error

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import dataclasses
 import logging
-import math
 import threading
 import time
 import uuid
@@ -25,6 +24,7 @@ from server.exercises.grading import judge_run, run_spec
 from server.hardware.backend import HardwareRobot
 from server.hardware.queue import QueueError
 from server.hardware.safety import MotionLimits
+from server.runs.recorder import json_safe
 from server.runs.result import RunResult
 from server.runs.run import Run
 from server.runs.spec import NodeSpec, RunSpec
@@ -234,8 +234,9 @@ class RunService:
         with self.store.session() as db:
             entry = inventory.by_name(db, name)
             if entry is None:
-                names = ", ".join(e.name for e in inventory.listing(db)) or "none registered"
-                raise RunRequestError(f"no robot named '{name}' on the bench; robots: {names}")
+                raise RunRequestError(
+                    f"no robot named '{name}' on the bench; robots: {inventory.names(db)}"
+                )
             kind, in_service = entry.kind, entry.in_service
             limits, watchdog_s = dict(entry.limits), entry.watchdog_s
         if kind != spec.robot:
@@ -312,12 +313,14 @@ class RunService:
             if result is not None:
                 record.sim_time_s = result.duration_s
                 record.wall_s = result.wall_s
-                record.metrics = _finite(result.metrics)
-                record.nodes = _finite(result.summary()["nodes"])
-            record.checks = _finite(checks)
+                record.metrics = json_safe(result.metrics)
+                record.nodes = json_safe(result.summary()["nodes"])
+            record.checks = json_safe(checks)
             record.score = score
         if checks:
-            active.telemetry.on_event({"type": "checks", "checks": _finite(checks), "score": score})
+            active.telemetry.on_event(
+                {"type": "checks", "checks": json_safe(checks), "score": score}
+            )
 
     # ------------------------------------------------------------------------------ controls
     def active(self, run_id: str) -> ActiveRun | None:
@@ -379,14 +382,3 @@ def _count(values) -> dict[str, int]:
     for value in values:
         counts[value] = counts.get(value, 0) + 1
     return counts
-
-
-def _finite(value):
-    """JSON columns take no NaN/inf (PostgreSQL refuses them): None stands for 'no value'."""
-    if isinstance(value, float):
-        return value if math.isfinite(value) else None
-    if isinstance(value, dict):
-        return {k: _finite(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_finite(v) for v in value]
-    return value

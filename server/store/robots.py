@@ -33,6 +33,11 @@ def by_address(db: Db, transport: str, address: str) -> RobotEntry | None:
     )
 
 
+def names(db: Db) -> str:
+    """The registered names, for a sentence about an unknown one."""
+    return ", ".join(e.name for e in listing(db)) or "none registered"
+
+
 def remove(db: Db, entry: RobotEntry) -> None:
     db.delete(entry)
     db.flush()

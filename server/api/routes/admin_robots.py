@@ -105,18 +105,17 @@ def list_robots(request: Request, _: Caller = Depends(instructor)) -> dict:
         return {"robots": [robot_out(e, request) for e in inventory.listing(db)]}
 
 
-def _entry(db, name: str) -> RobotEntry:
+def robot_or_404(db, name: str) -> RobotEntry:
     entry = inventory.by_name(db, name)
     if entry is None:
-        names = ", ".join(e.name for e in inventory.listing(db)) or "none registered"
-        raise HTTPException(404, f"no robot named '{name}'; robots: {names}")
+        raise HTTPException(404, f"no robot named '{name}'; robots: {inventory.names(db)}")
     return entry
 
 
 @router.patch("/{name}", summary="Take a robot out of service, or back in")
 def update_robot(name: str, body: RobotUpdate, request: Request) -> dict:
     with request.app.state.store.session() as db:
-        entry = _entry(db, name)
+        entry = robot_or_404(db, name)
         entry.in_service = body.in_service
         out = robot_out(entry, request)
     # Out of service: an offered turn waits, nobody loses their place; back: the next is offered.
@@ -128,5 +127,5 @@ def update_robot(name: str, body: RobotUpdate, request: Request) -> dict:
 @router.delete("/{name}", summary="Remove a robot from the inventory")
 def remove_robot(name: str, request: Request) -> dict:
     with request.app.state.store.session() as db:
-        inventory.remove(db, _entry(db, name))
+        inventory.remove(db, robot_or_404(db, name))
     return {"ok": True}

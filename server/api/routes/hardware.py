@@ -12,6 +12,7 @@ from fastapi.responses import JSONResponse
 from pydantic import Field
 
 from server.api.auth import Caller, current_user, instructor
+from server.api.routes.admin_robots import robot_or_404
 from server.api.schemas import Strict
 from server.hardware.queue import QueueError
 from server.store import robots as inventory
@@ -26,11 +27,7 @@ def _hub(request: Request):
 
 def _entry(request: Request, name: str) -> RobotEntry:
     with request.app.state.store.session() as db:
-        entry = inventory.by_name(db, name)
-        if entry is None:
-            names = ", ".join(e.name for e in inventory.listing(db)) or "none registered"
-            raise HTTPException(404, f"no robot named '{name}' on the bench; robots: {names}")
-        return entry
+        return robot_or_404(db, name)
 
 
 @router.get("/api/hardware", summary="The robots on the bench, their state and queues")

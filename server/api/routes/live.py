@@ -115,7 +115,7 @@ async def live(websocket: WebSocket, run_id: str) -> None:
     if caller is None:
         await websocket.close(code=NOT_LOGGED_IN_CODE, reason="not logged in")
         return
-    if record is None or (record.user_id != caller.id and not caller.is_instructor):
+    if record is None or not caller.can_see(record.user_id):
         await websocket.close(code=NOT_FOUND_CODE, reason="no such run (or it is not yours)")
         return
     service = app.state.runs

@@ -88,7 +88,7 @@ def run_out(record: RunRecord, service: RunService, with_code: bool = False) -> 
 def visible_run(request: Request, caller: Caller, run_id: str) -> RunRecord:
     with request.app.state.store.session() as db:
         record = run_store.get(db, run_id)
-    if record is None or (record.user_id != caller.id and not caller.is_instructor):
+    if record is None or not caller.can_see(record.user_id):
         raise HTTPException(404, NOT_FOUND)
     return record
 

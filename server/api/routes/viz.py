@@ -131,7 +131,7 @@ async def _visible_record(websocket: WebSocket, run_id: str):
                 return run_store.get(db, run_id)
 
         record = await run_in_threadpool(lookup)
-    if record is None or (record.user_id != caller.id and not caller.is_instructor):
+    if record is None or not caller.can_see(record.user_id):
         return None, (NOT_FOUND_CODE, NOT_FOUND)
     return record, None
 
