@@ -47,4 +47,8 @@ def test_bad_robot_entries_are_sentences(lab):
 def test_students_cannot_see_the_inventory(lab):
     student = lab.student("curious")
     assert student.get("/api/admin/robots").status_code == 404
-    assert student.post("/api/admin/robots", json={}).status_code in (404, 422)
+    valid = {"name": "sneaky", "kind": "crowbot", "address": "10.9.9.9"}
+    assert student.post("/api/admin/robots", json=valid).status_code == 404
+    assert "sneaky" not in [
+        r["name"] for r in lab.admin().get("/api/admin/robots").json()["robots"]
+    ]
