@@ -20,7 +20,6 @@ import uuid
 from collections import deque
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Protocol
 
 from sandbox.launcher import Launcher
 from sandbox.msgs import Time, get_message_class
@@ -33,6 +32,7 @@ from server.runs.bus import ROBOT, RUN, TopicBus
 from server.runs.controls import RunControls
 from server.runs.faults import Faults
 from server.runs.metrics import NodeMetrics
+from server.runs.outputs import RunObserver, RunOutputs
 from server.runs.recorder import Recorder
 from server.runs.result import RunEnd, RunResult
 from server.runs.spec import NodeSpec, RunSpec, RunSpecError
@@ -49,18 +49,6 @@ GOAL_TOPIC = "goal"  # RViz's "2D Nav Goal" idea: the run publishes the goal pos
 TF_PERIOD_NS = NS // 30  # [ns] /tf recorded at 30 Hz: smooth in Foxglove, small on disk
 MAP_MARGIN_M = 0.5  # [m] beyond the world's bounds by this much, the robot left the map
 LOG_LINES_KEPT = 2000  # per node in memory (the recording keeps them all)
-
-
-class RunObserver(Protocol):
-    """Watches a run live (the web service's telemetry hub). Called on the run's own thread,
-    so each method must be quick and must not raise; what it does with the data (coalescing,
-    dropping for slow viewers) is its business, never the run's."""
-
-    def on_message(self, topic: str, type_name: str, time_ns: int, data: bytes) -> None: ...
-
-    def on_logs(self, node: str, lines: list[str]) -> None: ...
-
-    def on_state(self, state: RunState, reason: str, time_s: float) -> None: ...
 
 
 @dataclass
@@ -83,7 +71,7 @@ class NodeSlot:
         return self.spec.name
 
 
-class Run(RunControls):
+class Run(RunControls, RunOutputs):
     def __init__(
         self,
         spec: RunSpec,
@@ -123,11 +111,7 @@ class Run(RunControls):
         with self._state_lock:
             check_transition(self.state, new)
             self.state = new
-        if self.observer is not None:
-            try:
-                self.observer.on_state(new, self.reason, self.time_ns / NS)
-            except Exception:  # a viewer's problem never ends a run
-                log.exception("run %s: the observer failed on a state change", self.run_id)
+        self._tell_state(new)
 
     def execute(self) -> RunResult:
         """Run to the end and return the result. Never raises for anything a node does."""
@@ -450,7 +434,7 @@ class Run(RunControls):
         if self.builtins:
             self.builtins.tick(self)
         if self.backend is not None:
-            self._robot_logs()
+            self._emit_logs("robot", self.backend.take_logs())  # the robot's own loginfo
         self._check_robot()
         if self.time_ns >= self._next_tf_ns:
             self._record_tf()
@@ -484,43 +468,3 @@ class Run(RunControls):
         )
         self.record("tf", message._type, self.time_ns, message.serialize())
         self._next_tf_ns = self.time_ns + TF_PERIOD_NS
-
-    def _robot_logs(self) -> None:
-        """A real robot's own log lines (rosserial loginfo) go into the run's log as node
-        'robot', beside the students' nodes."""
-        lines = self.backend.take_logs()
-        if not lines:
-            return
-        self.recorder.write_log("robot", lines)
-        if self.observer is not None:
-            try:
-                self.observer.on_logs("robot", lines)
-            except Exception:
-                log.exception("run %s: the observer failed on robot log lines", self.run_id)
-
-    def record(self, topic: str, type_name: str, time_ns: int, data: bytes) -> None:
-        """One message into the recording and, if someone watches, to the observer."""
-        self.recorder.record(topic, type_name, time_ns, data)
-        if self.observer is not None:
-            try:
-                self.observer.on_message(topic, type_name, time_ns, data)
-            except Exception:
-                log.exception("run %s: the observer failed on a message", self.run_id)
-                self.observer = None  # one report, not one per message
-
-    def _collect_logs(self, slot: NodeSlot) -> None:
-        if slot.process is None:
-            return
-        lines = slot.process.logs.take()
-        if lines:
-            self._log_lines(slot, lines)
-
-    def _log_lines(self, slot: NodeSlot, lines: list[str]) -> None:
-        slot.logs.extend(lines)
-        if self.recorder is not None:
-            self.recorder.write_log(slot.name, lines)
-        if self.observer is not None:
-            try:
-                self.observer.on_logs(slot.name, list(lines))
-            except Exception:
-                log.exception("run %s: the observer failed on log lines", self.run_id)

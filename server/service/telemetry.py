@@ -10,7 +10,7 @@ nothing is kept per message per viewer (viser's redundancy keys, taken to the en
   number; a viewer that fell behind the ring is told how many events it missed.
 
 Threads: the run calls ``on_message``/``on_logs``/``on_state`` on its own worker thread
-(``server.runs.run.RunObserver``); viewers live on the asyncio loop of the websocket. The run
+(``server.runs.outputs.RunObserver``); viewers live on the asyncio loop of the websocket. The run
 thread never blocks on a viewer: it swaps in the newest sample and, at most once per viewer
 until that viewer has woken, schedules a wake-up on the viewer's loop.
 
