@@ -12,6 +12,7 @@ A node's life, as the parent sees it:
     parent: Wake(time, deliveries)      <-- repeated: the node runs until it sleeps again
     child:  Yield(...)
     parent: Shutdown(reason)           (or the node ends by itself)
+    child:  Finishing(reason, published)   (hooks, figures and files still to come)
     child:  Exited(outcome, error, artifacts, notes)
 
 Every message payload crosses as ROS1 bytes with its type name (`Envelope`), so the wire format
@@ -80,9 +81,17 @@ class NodeInfo(msgspec.Struct, frozen=True):
     start_time_s: float = 0.0
     default_rate_hz: float = 10.0
     params: dict[str, object] = {}
-    # A run of several nodes may make new topics between them; a single node may only use the
-    # robot's topics, so a typo in a topic name is an error rather than a silent dead topic.
-    allow_new_topics: bool = False
+    # As in rospy, a node may publish and subscribe to any topic name (debug topics, topics
+    # between nodes, topics nobody listens to); a name close to one of the robot's topics gets a
+    # warning in the log instead ("did you mean 'Distance'?"). False refuses new names.
+    allow_new_topics: bool = True
+    # The node's command line after its file name, as rosrun passes it: `_speed:=0.2` sets the
+    # private parameter ~speed, `scan:=base_scan` remaps a name; rospy.myargv() drops both.
+    argv: list[str] = []
+    # Name remappings from a launch file's <remap> or `robodojo run --remap FROM:=TO`.
+    remaps: dict[str, str] = {}
+    # The node's namespace (a launch file's <group ns="...">, or <node ns="...">).
+    namespace: str = "/"
 
 
 class Envelope(msgspec.Struct, array_like=True, frozen=True):
@@ -114,11 +123,25 @@ class Load(msgspec.Struct, tag=True, frozen=True):
     filename: str
     api: Api
     info: NodeInfo
+    # The student's workspace data files (CSV, YAML, ...), written into the node's working
+    # directory before its code runs; relative paths, no "..".
+    files: list[Artifact] = []
+
+
+class GraphTopic(msgspec.Struct, array_like=True, frozen=True):
+    """One topic of the run's graph as nodes see it (rospy.get_published_topics, services)."""
+
+    name: str
+    type: str
+    publishers: list[str]
+    subscribers: list[str]
 
 
 class Wake(msgspec.Struct, tag=True, frozen=True):
     time_s: float
     deliveries: list[Envelope]
+    # The run's topic graph, sent only when it changed since this node's previous wake.
+    graph: list[GraphTopic] | None = None
 
 
 class Shutdown(msgspec.Struct, tag=True, frozen=True):
@@ -140,6 +163,20 @@ class Yield(msgspec.Struct, tag=True, frozen=True):
     published: list[Envelope]
     advertised: list[TopicDecl] = []
     subscribed: list[TopicDecl] = []
+    # Topics whose next message wakes the node before `wake_at_s` (a service's requests, the
+    # topic of wait_for_message, every subscription while spinning with a timer). None: only
+    # `wake_at_s`, or any message when `wake_at_s` is None (spin()).
+    wake_on: list[str] | None = None
+    unsubscribed: list[str] = []
+
+
+class Finishing(msgspec.Struct, tag=True, frozen=True):
+    """The node has ended its part in the run (signal_shutdown(), its script returned or
+    raised) and is finishing: shutdown hooks, figures, files. It will not sleep again; its
+    Exited follows within the end budget (sandbox/limits.py)."""
+
+    reason: str
+    published: list[Envelope] = []
 
 
 class Exited(msgspec.Struct, tag=True, frozen=True):
@@ -152,7 +189,7 @@ class Exited(msgspec.Struct, tag=True, frozen=True):
 
 
 ToChild = Load | Wake | Shutdown
-ToParent = Ready | Yield | Exited
+ToParent = Ready | Yield | Finishing | Exited
 
 
 class ProtocolError(RuntimeError):
