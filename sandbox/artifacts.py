@@ -37,10 +37,31 @@ def _regular_files(workdir: str) -> list[str]:
     return sorted(found)
 
 
+def write_workspace_files(workdir: str, files: list[Artifact]) -> dict[str, bytes]:
+    """Copy the student's workspace data files into the node's working directory (copy on
+    run: the node may change its copy; the workspace keeps the original). Returns what was
+    written, so `collect_artifacts` can leave unchanged inputs out of the artifacts. A path
+    that would leave the directory is skipped (the server checks paths too)."""
+    written: dict[str, bytes] = {}
+    for file in files:
+        name = os.path.normpath(file.name)
+        parts = name.split(os.sep)
+        if os.path.isabs(name) or any(part in ("", "..") or part.startswith(".") for part in parts):
+            continue
+        path = os.path.join(workdir, name)
+        os.makedirs(os.path.dirname(path), exist_ok=True)
+        with open(path, "wb") as out:
+            out.write(file.data)
+        written[name] = file.data
+    return written
+
+
 def collect_artifacts(
-    workdir: str, limits: Limits = DEFAULT_LIMITS
+    workdir: str, limits: Limits = DEFAULT_LIMITS, inputs: dict[str, bytes] | None = None
 ) -> tuple[list[Artifact], list[str]]:
-    """(artifacts, notes) for the files in `workdir`, within the caps of `limits`."""
+    """(artifacts, notes) for the files in `workdir`, within the caps of `limits`; workspace
+    files in `inputs` come back only if the node changed them."""
+    inputs = inputs or {}
     artifacts: list[Artifact] = []
     notes: list[str] = []
     total = 0
@@ -62,6 +83,8 @@ def collect_artifacts(
             notes.append(f"{name} skipped: {error.strerror}")
             continue
         size = max(size, len(data))
+        if inputs.get(name) == data:
+            continue  # a workspace file the node only read
         if size > limits.artifact_file_bytes:
             notes.append(
                 f"{name} ({_mb(size)}) skipped: over the {_mb(limits.artifact_file_bytes)} "

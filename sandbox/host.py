@@ -28,7 +28,7 @@ from contextlib import ExitStack
 from typing import ClassVar, Protocol
 
 from sandbox import runtime
-from sandbox.artifacts import collect_artifacts
+from sandbox.artifacts import collect_artifacts, write_workspace_files
 from sandbox.limits import DEFAULT_LIMITS, Limits
 from sandbox.protocol import Api, Clock, Exited, Load, NodeError, Outcome
 from sandbox.runtime import LinkLost, NodeFailure, NodeRuntime, ROSInterruptException
@@ -206,6 +206,7 @@ def run_node(link: Link, load: Load, workdir: str, limits: Limits = DEFAULT_LIMI
     node = NodeRuntime(link, load.info, NodeClock(load.info.clock, load.info.start_time_s))
     register_source(load.filename, load.code)
     error: BaseException | None = None
+    inputs = write_workspace_files(workdir, load.files)
     with ExitStack() as stack:
         _environment(stack, node, load, workdir)
         try:
@@ -217,7 +218,7 @@ def run_node(link: Link, load: Load, workdir: str, limits: Limits = DEFAULT_LIMI
         outcome, reason, problem = _finish(node, error, load)
         sys.stdout.flush()
         sys.stderr.flush()
-    artifacts, notes = collect_artifacts(workdir, limits)
+    artifacts, notes = collect_artifacts(workdir, limits, inputs)
     return Exited(
         outcome=outcome,
         reason=reason,

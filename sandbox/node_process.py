@@ -28,6 +28,7 @@ from sandbox.limits import Limits
 from sandbox.logstream import LogStream
 from sandbox.protocol import (
     Api,
+    Artifact,
     Envelope,
     Exited,
     FrameReader,
@@ -171,14 +172,22 @@ class NodeProcess:
         return False
 
     # ----------------------------------------------------------------------------- driving
-    def load(self, code: str, filename: str, api: Api, info: NodeInfo) -> Yield | Exited:
-        """Give the idle node its code; returns its first Yield (setup done) or its end."""
+    def load(
+        self,
+        code: str,
+        filename: str,
+        api: Api,
+        info: NodeInfo,
+        files: list[Artifact] | None = None,
+    ) -> Yield | Exited:
+        """Give the idle node its code (and the workspace's data files for its working
+        directory); returns its first Yield (setup done) or its end."""
         if not self.wait_ready():
             return self._end_reply()
         self.name = info.node_name
         self.time_s = info.start_time_s
         self._move(NodeState.RUNNING)
-        self._send(Load(code=code, filename=filename, api=api, info=info))
+        self._send(Load(code=code, filename=filename, api=api, info=info, files=files or []))
         self._expect(self.limits.first_step_budget_s, "first step")
         return self.poll_reply(None)
 

@@ -26,7 +26,16 @@ from sandbox.msgs import Time, get_message_class
 from sandbox.msgs.geometry_msgs import Point, Pose, PoseStamped, Quaternion
 from sandbox.msgs.std_msgs import Header
 from sandbox.node_process import NodeProcess
-from sandbox.protocol import Clock, Envelope, Exited, NodeInfo, Outcome, RobotTopic, Yield
+from sandbox.protocol import (
+    Artifact,
+    Clock,
+    Envelope,
+    Exited,
+    NodeInfo,
+    Outcome,
+    RobotTopic,
+    Yield,
+)
 from server.runs.builtin_host import BuiltinHost
 from server.runs.bus import ROBOT, RUN, TopicBus
 from server.runs.controls import RunControls
@@ -189,8 +198,10 @@ class Run(RunControls, RunOutputs):
             velocity_topic=velocity,
             clock=self.spec.clock,
             start_time_s=0.0,
-            params=dict(self.spec.params),
-            allow_new_topics=len(self.spec.nodes) > 1,
+            params={**self.spec.params, **node.params},
+            argv=list(node.args),
+            remaps=dict(node.remaps),
+            namespace=node.namespace,
         )
 
     def _start_nodes(self) -> None:
@@ -198,9 +209,12 @@ class Run(RunControls, RunOutputs):
             self.bus.add_node(slot.name)
             slot.process = self.launcher.start(slot.name)
         replies = []
+        files = [Artifact(path, data) for path, data in self.spec.files]
         for slot in self.slots.values():
             node = slot.spec
-            reply = slot.process.load(node.code, node.filename, node.api, self._node_info(node))
+            reply = slot.process.load(
+                node.code, node.filename, node.api, self._node_info(node), files
+            )
             replies.append((slot, reply))
         # Every node's subscriptions are known before anything published at start-up is
         # routed, so launch-file order does not lose a first message (as a latched topic).

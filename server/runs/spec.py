@@ -25,12 +25,20 @@ class RunSpecError(ValueError):
 
 @dataclass(frozen=True, slots=True)
 class NodeSpec:
-    """One node: a name (as in a launch file), its code, the file name its tracebacks show."""
+    """One node: a name (as in a launch file), its code, the file name its tracebacks show,
+    and what rosrun or a launch file would give it: parameters, remappings, arguments and a
+    namespace."""
 
     name: str
     code: str
     filename: str
     api: Api = Api.AUTO
+    # Parameter name -> value, names as a launch file's <param> gives them: "~speed" (private),
+    # "/max_speed" (global) or "gain" (relative to the node's namespace).
+    params: dict[str, object] = field(default_factory=dict)
+    remaps: tuple[tuple[str, str], ...] = ()  # (from, to) name pairs, as <remap from to>
+    args: tuple[str, ...] = ()  # command-line arguments after the file name (rosrun style)
+    namespace: str = "/"  # <group ns="..."> / <node ns="...">
 
     @classmethod
     def from_file(cls, path: str | Path, name: str | None = None) -> NodeSpec:
@@ -63,6 +71,8 @@ class RunSpec:
     # Scripted controls: (run time [s], action, value), e.g. (10.0, "light", ("lamp", 1.5, 1)).
     script: tuple[tuple[float, str, object], ...] = ()
     builtin_nodes: tuple[str, ...] = ()  # trusted helpers: map_server, localization, ...
+    # Workspace data files (relative path, bytes) copied into every node's working directory.
+    files: tuple[tuple[str, bytes], ...] = ()
 
     def validate(self) -> None:
         """Raise RunSpecError naming the first problem found."""

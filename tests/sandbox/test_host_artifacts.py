@@ -5,9 +5,9 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from sandbox.artifacts import collect_artifacts
+from sandbox.artifacts import collect_artifacts, write_workspace_files
 from sandbox.limits import Limits, MiB
-from sandbox.protocol import Outcome
+from sandbox.protocol import Artifact, Outcome
 from tests.sandbox.test_host_harness import Parent, run
 
 
@@ -68,3 +68,24 @@ def test_artifacts_are_collected_after_an_error_too(tmp_path: Path) -> None:
     exited = parent.next()
     assert exited.outcome is Outcome.ERROR
     assert [a.name for a in exited.artifacts] == ["partial.csv"]
+
+
+def test_workspace_files_are_copied_in_and_only_changed_ones_come_back(tmp_path: Path) -> None:
+    files = [
+        Artifact("data/waypoints.csv", b"x,y\n1,2\n"),
+        Artifact("gains.yaml", b"kp: 0.5\n"),
+        Artifact("../escape.txt", b"no"),
+        Artifact("/etc/passwd", b"no"),
+        Artifact(".hidden/x", b"no"),
+    ]
+    inputs = write_workspace_files(str(tmp_path), files)
+    assert sorted(inputs) == [os.path.join("data", "waypoints.csv"), "gains.yaml"]
+    assert (tmp_path / "data" / "waypoints.csv").read_bytes() == b"x,y\n1,2\n"
+    assert not (tmp_path.parent / "escape.txt").exists()
+    (tmp_path / "gains.yaml").write_bytes(b"kp: 0.7\n")  # the node tuned its copy
+    (tmp_path / "plot.png").write_bytes(b"png")
+    artifacts, _ = collect_artifacts(str(tmp_path), inputs=inputs)
+    assert {(a.name, a.data) for a in artifacts} == {
+        ("gains.yaml", b"kp: 0.7\n"),
+        ("plot.png", b"png"),
+    }
