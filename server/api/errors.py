@@ -18,6 +18,7 @@ from server.runs.spec import RunSpecError
 from server.service.catalog import UnknownIdError
 from server.service.exercises import ExerciseDefinitionError
 from server.service.runs import RunLimitError, RunRequestError
+from server.service.workspace_files import WorkspaceFileError
 
 log = logging.getLogger("robodojo.api")
 
@@ -64,6 +65,10 @@ async def _bad_run(_: Request, error: Exception) -> JSONResponse:
     return JSONResponse(status_code=422, content={"detail": str(error)})
 
 
+async def _bad_file(_: Request, error: WorkspaceFileError) -> JSONResponse:
+    return JSONResponse(status_code=error.status, content={"detail": str(error)})
+
+
 async def _broken_exercise(_: Request, error: Exception) -> JSONResponse:
     return JSONResponse(
         status_code=409,
@@ -102,6 +107,7 @@ def install(app: FastAPI) -> None:
     app.add_exception_handler(RunLimitError, _run_limit)
     app.add_exception_handler(RunRequestError, _bad_run)
     app.add_exception_handler(RunSpecError, _bad_run)
+    app.add_exception_handler(WorkspaceFileError, _bad_file)
     app.add_exception_handler(ExerciseDefinitionError, _broken_exercise)
     app.add_exception_handler(DataError, _data_error)
     app.add_exception_handler(Exception, _internal)

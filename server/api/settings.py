@@ -27,7 +27,9 @@ class Settings(BaseSettings):
     max_run_duration_s: float = Field(600.0, gt=0)  # [s] ten minutes of robot time
     max_code_bytes_per_file: int = Field(256 * KIB, ge=1)  # [B] far beyond any exercise
     max_code_bytes_per_run: int = Field(1024 * KIB, ge=1)  # [B] all nodes of one run
-    max_files_per_workspace: int = Field(16, ge=1)
+    max_files_per_workspace: int = Field(32, ge=1)  # a package: nodes, launch, config, data
+    max_data_bytes_per_file: int = Field(1024 * KIB, ge=1)  # [B] a long CSV log, a big YAML map
+    max_workspace_bytes: int = Field(4096 * KIB, ge=1)  # [B] newest versions; every run copies it
     retry_after_s: int = Field(10, ge=1)  # [s] told to a client that hit a run limit
 
     # Real robots: CrowBots (ros_lib over WiFi) connect to this TCP port; rosserial_python's

@@ -56,12 +56,14 @@ class RunRequest:
     robot: str | None
     world: str | None
     exercise: ExerciseEntry | None
-    nodes: tuple[tuple[str, str], ...]  # (name, code)
+    nodes: tuple[NodeSpec, ...]  # code, parameters, remappings, arguments, namespace
     clock: Clock | None
     duration_s: float | None
     seed: int | None
     teleop: bool = False  # the teleop built-in: arrow keys from the browser drive the robot
     hardware: str | None = None  # a robot on the bench (inventory name) instead of simulation
+    params: dict[str, object] = field(default_factory=dict)  # a launch file's global <param>s
+    files: tuple[tuple[str, bytes], ...] = ()  # workspace data files, into every node's folder
 
 
 @dataclass
@@ -128,12 +130,12 @@ class RunService:
         if not request.nodes:
             raise RunRequestError("a run needs at least one node: send nodes=[{name, code}]")
         total = 0
-        for name, code in request.nodes:
-            size = len(code.encode())
+        for node in request.nodes:
+            size = len(node.code.encode())
             total += size
             if size > settings.max_code_bytes_per_file:
                 raise RunRequestError(
-                    f"node '{name}' has {size} bytes of code; the limit per file is "
+                    f"node '{node.name}' has {size} bytes of code; the limit per file is "
                     f"{settings.max_code_bytes_per_file} bytes"
                 )
         if total > settings.max_code_bytes_per_run:
@@ -147,9 +149,7 @@ class RunService:
                 f"duration {duration:g} s is longer than this lab allows "
                 f"({settings.max_run_duration_s:g} s)"
             )
-        nodes = tuple(
-            NodeSpec(name=name, code=code, filename=f"{name}.py") for name, code in request.nodes
-        )
+        nodes = request.nodes
         if request.exercise is not None:
             exercise = request.exercise.exercise
             seed = request.seed if request.seed is not None else exercise.seeds[0]
@@ -168,6 +168,10 @@ class RunService:
                 duration_s=duration if duration is not None else 30.0,
                 seed=request.seed or 0,
             )
+        if request.params:  # the exercise's own parameters win: its checks depend on them
+            spec = _replace(spec, params={**request.params, **spec.params})
+        if request.files:
+            spec = _replace(spec, files=request.files)
         if request.teleop and "teleop" not in spec.builtin_nodes:
             spec = _replace(spec, builtin_nodes=(*spec.builtin_nodes, "teleop"))
         spec.validate()  # RunSpecError: the caller turns it into a 422
@@ -371,6 +375,12 @@ class RunService:
             "max_runs_per_student": self.settings.max_runs_per_student,
             "live_viewers": self.telemetry.viewer_count(),
         }
+
+
+def node_spec(name: str, code: str, **ros) -> NodeSpec:
+    """A node sent as code (the page's editor, an exercise's files): its file is `<name>.py`;
+    `ros` is params, remaps, args and namespace, as NodeSpec takes them."""
+    return NodeSpec(name=name, code=code, filename=f"{name}.py", **ros)
 
 
 def _replace(spec: RunSpec, **changes) -> RunSpec:

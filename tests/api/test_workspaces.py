@@ -51,6 +51,6 @@ def test_a_workspace_must_name_an_exercise_or_a_robot(lab):
     assert "crowbot" in answer.json()["valid"] and "crowbot_distance_pid" in answer.json()["valid"]
     too_many = [
         student.put(f"/api/workspaces/crowbot/files/f{i}.py", json={"code": ""}).status_code
-        for i in range(17)
+        for i in range(33)
     ]
-    assert too_many[:16] == [200] * 16 and too_many[16] == 422
+    assert too_many[:32] == [200] * 32 and too_many[32] == 422

@@ -25,7 +25,7 @@ from server.exercises.registry import exercise_ids
 from server.service import catalog, exercises
 from server.service.catalog import ExerciseEntry, UnknownIdError, registry_entry
 from server.service.exercises import ExerciseDefinitionError
-from server.service.runs import RunRequest
+from server.service.runs import RunRequest, node_spec
 from server.store.models import CustomExercise
 
 router = APIRouter(prefix="/api/admin", tags=["admin"], dependencies=[Depends(instructor)])
@@ -288,11 +288,11 @@ def try_exercise(exercise_id: str, request: Request, caller: Caller = Depends(in
     with request.app.state.store.session() as db:
         entry = find_buildable(db, exercise_id)
     if entry.custom:
-        nodes = tuple((name, code) for name, _, code in entry.starter)
+        nodes = tuple(node_spec(name, code) for name, _, code in entry.starter)
         code = "starter"
     else:
         exercise = entry.exercise
-        nodes = tuple((f["name"], f["code"]) for f in _files(exercise.reference, exercise))
+        nodes = tuple(node_spec(f["name"], f["code"]) for f in _files(exercise.reference, exercise))
         code = "reference"
     service = request.app.state.runs
     record = service.start(

@@ -20,9 +20,10 @@ from server.api.schemas import RunCommand, RunCreate
 from server.runs.export import csv_file_name, export_csv
 from server.runs.recorder import ARTIFACTS_DIR, LOGS_DIR, RECORDING_FILE
 from server.runs.safe_paths import inside, safe_relative_path
+from server.runs.spec import NodeSpec
 from server.runs.state import RunState
-from server.service import catalog, exercises
-from server.service.runs import RunRequest, RunService
+from server.service import catalog, exercises, workspace_files, workspace_runs
+from server.service.runs import RunRequest, RunService, node_spec
 from server.store import runs as run_store
 from server.store.models import RunRecord
 
@@ -120,6 +121,7 @@ def create(body: RunCreate, request: Request, caller: Caller = Depends(current_u
             )
         catalog.check_robot(body.robot)
         catalog.check_world(body.world)
+    nodes, params, files = _nodes_and_files(request, caller, body, entry)
     gated = request.app.state.settings.hardware_gate and (
         entry is None or entry.exercise.hardware_gate
     )
@@ -129,7 +131,7 @@ def create(body: RunCreate, request: Request, caller: Caller = Depends(current_u
         robot = entry.exercise.robot if entry else body.robot
         verdict = simulation_gate(
             request, caller.id, entry.exercise.id if entry else None, robot,
-            [{"name": n.name, "code": n.code} for n in body.nodes],
+            [{"name": n.name, "code": n.code} for n in nodes],
         )  # fmt: skip
         if not verdict["passed"]:
             return gate_refusal(verdict)
@@ -137,15 +139,47 @@ def create(body: RunCreate, request: Request, caller: Caller = Depends(current_u
         robot=body.robot,
         world=body.world,
         exercise=entry,
-        nodes=tuple((node.name, node.code) for node in body.nodes),
+        nodes=nodes,
         teleop=body.teleop,
         hardware=body.hardware,
         clock=Clock(body.clock) if body.clock else None,
         duration_s=body.duration,
         seed=body.seed,
+        params=params,
+        files=files,
     )
     record = service.start(caller.id, request_)
     return run_out(record, service)
+
+
+def _nodes_and_files(
+    request: Request, caller: Caller, body: RunCreate, entry
+) -> tuple[tuple[NodeSpec, ...], dict[str, object], tuple[tuple[str, bytes], ...]]:
+    """The nodes (sent, or named by a launch file of the caller's workspace), the launch
+    file's global parameters and the workspace's data files for every node."""
+    workspace = body.workspace
+    if workspace is None and body.launch is not None:
+        workspace = entry.exercise.id if entry else body.robot
+    files: dict[str, str] = {}
+    if workspace is not None:
+        with request.app.state.store.session() as db:
+            files = workspace_runs.contents(db, caller.id, workspace)
+    params: dict[str, object] = {}
+    if body.launch is not None:
+        nodes, params = workspace_runs.launch_nodes(files, body.launch.file, body.launch.args)
+    else:
+        nodes = tuple(
+            node_spec(
+                n.name,
+                n.code,
+                params=dict(n.params),
+                remaps=tuple(n.remaps.items()),
+                args=tuple(n.args),
+                namespace=n.namespace,
+            )
+            for n in body.nodes or ()
+        )
+    return nodes, params, workspace_files.data_files(files.items())
 
 
 @router.get("", summary="My runs, newest first")

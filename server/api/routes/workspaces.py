@@ -1,6 +1,7 @@
-"""Students' code: a workspace per exercise (or per robot, for free play), one file per node,
-every save kept as a version. Only the owner sees a workspace; an empty one starts from the
-exercise's starter code."""
+"""Students' code: a workspace per exercise (or per robot, for free play), one file per node and
+the data files next to them (CSV, YAML, JSON, TXT, launch files: server/service/
+workspace_files.py), every save kept as a version. Only the owner sees a workspace; an empty one
+starts from the exercise's starter code."""
 
 from __future__ import annotations
 
@@ -9,31 +10,23 @@ from fastapi import APIRouter, Depends, HTTPException, Path, Request
 from server.api.auth import Caller, current_user
 from server.api.routes.runs import iso
 from server.api.schemas import CodeSave
-from server.service import exercises
-from server.service.catalog import UnknownIdError
-from server.sim import robot_ids
+from server.service import workspace_files, workspace_runs
 from server.store import workspaces as store
 from server.store.models import CodeVersion
 
 router = APIRouter(prefix="/api/workspaces", tags=["workspaces"])
-FILE_PATTERN = r"^[A-Za-z][A-Za-z0-9_]{0,39}(\.py)?$"
-FileName = Path(pattern=FILE_PATTERN, description="node file: a node name, optionally .py")
+FileName = Path(
+    max_length=200,
+    description="a node name (pid, pid.py) or a data file's path (waypoints.csv, config/a.yaml)",
+)
 WorkspaceId = Path(max_length=64)
 VersionNumber = Path(ge=1, le=2**31 - 1, description="a version number, from 1")
 
 
 def _starter(request: Request, workspace: str) -> list[tuple[str, str]]:
     """(file name, code) to start from; raises 404 for a workspace that names nothing."""
-    if workspace in robot_ids():
-        return []
     with request.app.state.store.session() as db:
-        try:
-            entry = exercises.find(db, workspace)
-        except UnknownIdError as error:
-            raise UnknownIdError(
-                "workspace (an exercise or robot)", workspace, [*error.valid, *robot_ids()]
-            ) from None
-    return [(f"{name}.py", code) for name, _, code in entry.starter]
+        return workspace_runs.starter_files(db, workspace)
 
 
 def _version_out(version: CodeVersion, with_code: bool = True) -> dict:
@@ -42,6 +35,7 @@ def _version_out(version: CodeVersion, with_code: bool = True) -> dict:
         "version": version.version,
         "saved_at": iso(version.created_at),
         "bytes": len(version.code.encode()),
+        "kind": "code" if workspace_files.is_code(version.filename) else "data",
     }
     if with_code:
         out["code"] = version.code
@@ -49,7 +43,16 @@ def _version_out(version: CodeVersion, with_code: bool = True) -> dict:
 
 
 def _filename(name: str) -> str:
-    return name if name.endswith(".py") else f"{name}.py"
+    return workspace_files.file_name(name)  # WorkspaceFileError: a 4xx with its sentence
+
+
+def caps(settings) -> workspace_files.Caps:
+    return workspace_files.Caps(
+        code_bytes=settings.max_code_bytes_per_file,
+        data_bytes=settings.max_data_bytes_per_file,
+        workspace_bytes=settings.max_workspace_bytes,
+        files=settings.max_files_per_workspace,
+    )
 
 
 @router.get("/{workspace}", summary="My files in a workspace (newest versions)")
@@ -62,14 +65,21 @@ def get_workspace(
     saved = {f["filename"] for f in files}
     # Starter files not saved yet (version 0), so a four-node exercise keeps its four files.
     files += [
-        {"filename": name, "version": 0, "saved_at": None, "bytes": len(code), "code": code}
+        {
+            "filename": name,
+            "version": 0,
+            "saved_at": None,
+            "bytes": len(code),
+            "kind": "code",
+            "code": code,
+        }
         for name, code in starter
         if name not in saved
     ]
     return {"workspace": workspace, "files": sorted(files, key=lambda f: f["filename"])}
 
 
-@router.delete("/{workspace}/files/{filename}", summary="Delete a file and its versions")
+@router.delete("/{workspace}/files/{filename:path}", summary="Delete a file and its versions")
 def delete_file(
     request: Request,
     workspace: str = WorkspaceId,
@@ -83,7 +93,7 @@ def delete_file(
     return {"ok": True, "versions_removed": removed}
 
 
-@router.put("/{workspace}/files/{filename}", summary="Save a file (a new version)")
+@router.put("/{workspace}/files/{filename:path}", summary="Save a file (a new version)")
 def save_file(
     body: CodeSave,
     request: Request,
@@ -92,23 +102,18 @@ def save_file(
     caller: Caller = Depends(current_user),
 ) -> dict:
     _starter(request, workspace)
-    settings = request.app.state.settings
-    size = len(body.code.encode())
-    if size > settings.max_code_bytes_per_file:
-        raise HTTPException(
-            413, f"the file has {size} bytes; the limit is {settings.max_code_bytes_per_file}"
-        )
     name = _filename(filename)
+    limits = caps(request.app.state.settings)
+    workspace_files.check_content(name, body.code, limits)
     with request.app.state.store.session() as db:
-        names = {v.filename for v in store.latest_files(db, caller.id, workspace)}
-        if name not in names and len(names) >= settings.max_files_per_workspace:
-            raise HTTPException(
-                422, f"a workspace holds at most {settings.max_files_per_workspace} files"
-            )
+        sizes = {
+            v.filename: len(v.code.encode()) for v in store.latest_files(db, caller.id, workspace)
+        }
+        workspace_files.check_fits(name, body.code, sizes, limits)
         return _version_out(store.save(db, caller.id, workspace, name, body.code), False)
 
 
-@router.get("/{workspace}/files/{filename}/versions", summary="A file's saved versions")
+@router.get("/{workspace}/files/{filename:path}/versions", summary="A file's saved versions")
 def list_versions(
     request: Request,
     workspace: str = WorkspaceId,
@@ -130,7 +135,7 @@ def _one_version(request: Request, caller: Caller, workspace: str, filename: str
     return version
 
 
-@router.get("/{workspace}/files/{filename}/versions/{number}", summary="One saved version")
+@router.get("/{workspace}/files/{filename:path}/versions/{number}", summary="One saved version")
 def get_version(
     request: Request,
     number: int = VersionNumber,
@@ -142,7 +147,7 @@ def get_version(
 
 
 @router.post(
-    "/{workspace}/files/{filename}/versions/{number}/restore",
+    "/{workspace}/files/{filename:path}/versions/{number}/restore",
     summary="Make an old version the newest again (saved as a new version)",
 )
 def restore_version(
