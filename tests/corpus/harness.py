@@ -1,0 +1,259 @@
+"""Drive a corpus case through the real run engine and read back what it left: the run's
+state, the recording (every topic, and the true pose on ``/tf``), the nodes' logs, their
+artifacts, the topic graph and the metrics.
+
+Two ways in, both the real thing: ``server.runs.run.Run`` with the real sandbox launcher for
+scripts, and the ``robodojo run`` command line for launch files (as a student types it). Either
+way everything a check reads comes from the run's output folder, so one check serves both.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import struct
+import subprocess
+import sys
+from dataclasses import dataclass, field
+from functools import cached_property
+from pathlib import Path
+
+from mcap.reader import make_reader
+
+from sandbox.msgs import get_message_class
+from sandbox.protocol import Clock
+from server.runs.run import Run
+from server.runs.spec import NodeSpec, RunSpec
+
+SCRIPTS = Path(__file__).parent / "scripts"
+REPO = Path(__file__).parents[2]
+NS = 1_000_000_000
+WORLD_FRAME = "map"
+BODY_FRAMES = ("base_link", "base_footprint")  # the robot's body in the recording's /tf
+CLI_TIMEOUT_S = 120.0  # [s] a launch-file run of a few seconds plus its sandbox start-up
+
+
+@dataclass(frozen=True)
+class Node:
+    """One script of a case, with what rosrun or a launch file would give it."""
+
+    file: str
+    name: str | None = None
+    params: dict[str, object] = field(default_factory=dict)
+    remaps: tuple[tuple[str, str], ...] = ()
+    args: tuple[str, ...] = ()
+
+    @property
+    def node_name(self) -> str:
+        return self.name or Path(self.file).stem
+
+
+@dataclass(frozen=True)
+class Pose:
+    t: float  # [s] run time
+    x: float  # [m] world frame
+    y: float  # [m]
+    yaw: float  # [rad] counter-clockwise from +x
+
+
+@dataclass
+class Outcome:
+    """What a run left behind, read from its output folder."""
+
+    state: str
+    reason: str
+    out_dir: Path
+    clock: Clock
+
+    @cached_property
+    def recording(self) -> dict[str, list[tuple[float, object]]]:
+        """Topic (without its leading /) -> [(time [s], message)] in recording order."""
+        topics: dict[str, list[tuple[float, object]]] = {}
+        with open(self.out_dir / "recording.mcap", "rb") as f:
+            for schema, channel, message in make_reader(f).iter_messages():
+                decoded = get_message_class(schema.name).deserialize(message.data)
+                topics.setdefault(channel.topic.lstrip("/"), []).append(
+                    (message.log_time / NS, decoded)
+                )
+        return topics
+
+    def messages(self, topic: str) -> list[tuple[float, object]]:
+        return self.recording.get(topic.lstrip("/"), [])
+
+    @cached_property
+    def poses(self) -> list[Pose]:
+        """The robot's true pose over the run, from the recording's map -> body transform."""
+        poses = []
+        for time_s, tf in self.messages("tf"):
+            for transform in tf.transforms:
+                if (
+                    transform.header.frame_id == WORLD_FRAME
+                    and transform.child_frame_id in BODY_FRAMES
+                ):
+                    q = transform.transform.rotation
+                    yaw = math.atan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y * q.y + q.z * q.z))
+                    t = transform.transform.translation
+                    poses.append(Pose(time_s, t.x, t.y, yaw))
+                    break
+        assert poses, f"the recording has no {WORLD_FRAME} -> body transform on /tf"
+        return poses
+
+    def pose_at(self, time_s: float) -> Pose:
+        """The recorded pose nearest to `time_s`."""
+        return min(self.poses, key=lambda pose: abs(pose.t - time_s))
+
+    @property
+    def start(self) -> Pose:
+        return self.poses[0]
+
+    @property
+    def end(self) -> Pose:
+        return self.poses[-1]
+
+    def travelled_between(self, t0: float, t1: float) -> float:
+        """Straight-line distance [m] between the poses at t0 and t1."""
+        a, b = self.pose_at(t0), self.pose_at(t1)
+        return math.hypot(b.x - a.x, b.y - a.y)
+
+    def turned(self) -> float:
+        """Total signed heading change [rad] over the run, unwrapped."""
+        total = 0.0
+        for a, b in zip(self.poses, self.poses[1:], strict=False):
+            total += math.atan2(math.sin(b.yaw - a.yaw), math.cos(b.yaw - a.yaw))
+        return total
+
+    def log(self, node: str) -> str:
+        path = self.out_dir / "logs" / f"{node}.log"
+        return path.read_text() if path.is_file() else ""
+
+    @cached_property
+    def logs(self) -> dict[str, str]:
+        folder = self.out_dir / "logs"
+        return {p.stem: p.read_text() for p in folder.glob("*.log")} if folder.is_dir() else {}
+
+    def artifact(self, node: str, name: str) -> Path:
+        return self.out_dir / "artifacts" / node / name
+
+    @cached_property
+    def metrics(self) -> dict:
+        return json.loads((self.out_dir / "metrics.json").read_text())
+
+    @cached_property
+    def graph(self) -> dict[str, dict]:
+        """Topic name (without its leading /) -> publishers, subscribers, messages, rate."""
+        document = json.loads((self.out_dir / "graph.json").read_text())
+        return {topic["name"].lstrip("/"): topic for topic in document["topics"]}
+
+    def describe(self) -> str:
+        """The run's end and every log's tail, for an assertion message."""
+        tails = {name: text.splitlines()[-12:] for name, text in self.logs.items()}
+        return f"{self.state}: {self.reason}; logs: {json.dumps(tails, indent=1)}"
+
+
+def png_size(path: Path) -> tuple[int, int]:
+    """(width, height) [px] from a PNG's IHDR chunk."""
+    data = path.read_bytes()[:24]
+    assert data[:8] == b"\x89PNG\r\n\x1a\n", f"{path.name} is not a PNG"
+    return struct.unpack(">II", data[16:24])
+
+
+def run_scripts(
+    launcher,
+    out_dir: Path,
+    *,
+    robot: str,
+    world: str,
+    nodes: tuple[Node, ...],
+    clock: Clock,
+    duration_s: float,
+    spawn: str | None = None,
+    initial_pose: tuple[float, float, float] | None = None,
+    files: tuple[str, ...] = (),
+    seed: int = 1,
+) -> Outcome:
+    """Run the scripts unchanged as nodes of one run (server.runs.run.Run)."""
+    specs = []
+    for node in nodes:
+        # Only what a case uses is passed, so a case without parameters or remappings runs on
+        # an engine that does not have them yet.
+        extra = {}
+        if node.params:
+            extra["params"] = dict(node.params)
+        if node.remaps:
+            extra["remaps"] = node.remaps
+        if node.args:
+            extra["args"] = node.args
+        path = SCRIPTS / node.file
+        specs.append(
+            NodeSpec(
+                name=node.node_name,
+                code=path.read_text(encoding="utf-8"),
+                filename=path.name,
+                **extra,
+            )
+        )
+    options: dict[str, object] = {}
+    if files:
+        options["files"] = tuple((name, (SCRIPTS / name).read_bytes()) for name in files)
+    spec = RunSpec(
+        robot=robot,
+        world=world,
+        nodes=tuple(specs),
+        clock=clock,
+        duration_s=duration_s,
+        seed=seed,
+        spawn=spawn,
+        initial_pose=initial_pose,
+        **options,
+    )
+    result = Run(spec, launcher, out_dir).execute()
+    return Outcome(str(result.state), result.reason, out_dir, clock)
+
+
+def run_launch_file(
+    out_dir: Path,
+    *,
+    launch: str,
+    robot: str,
+    world: str,
+    clock: Clock,
+    duration_s: float,
+    spawn: str | None = None,
+    seed: int = 1,
+) -> Outcome:
+    """Run a launch file as a student would: `robodojo run --launch FILE`."""
+    command = [
+        sys.executable,
+        "-m",
+        "server.cli",
+        "run",
+        "--robot",
+        robot,
+        "--world",
+        world,
+        "--launch",
+        str(SCRIPTS / launch),
+        "--clock",
+        clock.value,
+        "--duration",
+        str(duration_s),
+        "--seed",
+        str(seed),
+        "--out",
+        str(out_dir),
+    ]
+    if spawn:
+        command += ["--spawn", spawn]
+    done = subprocess.run(
+        command, cwd=REPO, capture_output=True, text=True, timeout=CLI_TIMEOUT_S, check=False
+    )
+    lines = done.stdout.strip().splitlines()
+    assert lines, f"robodojo run printed nothing (exit {done.returncode}): {done.stderr.strip()}"
+    try:
+        summary = json.loads(lines[-1])
+    except json.JSONDecodeError:
+        raise AssertionError(
+            f"robodojo run did not end with its JSON summary: {done.stdout[-500:]}"
+            f"{done.stderr[-1500:]}"
+        ) from None
+    return Outcome(summary["state"], summary["reason"], out_dir, clock)

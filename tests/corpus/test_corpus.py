@@ -1,0 +1,618 @@
+"""ROS 1 course scripts run unchanged (issue 12): each script in tests/corpus/scripts/ is written
+the way course material writes it, run through the real run engine and sandbox on both clocks,
+and judged on behaviour: where the robot went (the true pose from the recording), which messages
+flowed between nodes (recorded topics, the run's graph), what the logs say and which figures and
+files came back.
+
+Geometry used by the checks (server/sim/worlds/*.toml):
+- wall_approach: the board's face at x = 1.40 m; the CrowBot starts at x = 0.75 m facing it
+  with its ultrasonic sensor 0.05 m ahead of its centre, so the sensor reads 1.35 - x [m].
+- light_arena: the CrowBot at (1, 1) facing +x, the lamp 0.6 m to its left (+y).
+- office: the lab spawn "start" at (2.0, 1.3) facing +y with 1.2 m free ahead; the corridor
+  between y = 2.5 and y = 3.7, its south wall unbroken for 2.4 < x < 5.6 and its north wall
+  for 1.8 < x < 5.0.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+import re
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import pytest
+
+from sandbox.protocol import Clock
+from tests.corpus.harness import SCRIPTS, Node, Outcome, png_size, run_launch_file, run_scripts
+
+BOARD_X_M = 1.40  # [m] wall_approach: the board's face
+CROWBOT_SENSOR_AHEAD_M = 0.05  # [m] ultrasonic sensor ahead of the CrowBot's centre
+FIGURE_PX = (2400, 1200)  # [px] the CrowBot paper's figures: 12 x 6 in at 200 dpi
+STILL_M = 0.01  # [m] less than this between two poses: the robot stood still
+FINISHED = ("finished: duration reached", "finished: every node ended")
+
+
+def sensor_distance(x_m: float) -> float:
+    """The CrowBot's ultrasonic range [m] to the board from its centre's x in wall_approach."""
+    return BOARD_X_M - CROWBOT_SENSOR_AHEAD_M - x_m
+
+
+def angle_between(a: float, b: float) -> float:
+    return math.atan2(math.sin(a - b), math.cos(a - b))
+
+
+def assert_still_after(outcome: Outcome, time_s: float) -> None:
+    moved = outcome.travelled_between(time_s, outcome.end.t)
+    assert moved < STILL_M, f"the robot still moved {moved:.3f} m after t={time_s} s"
+
+
+def assert_log(outcome: Outcome, node: str, pattern: str) -> re.Match:
+    match = re.search(pattern, outcome.log(node))
+    assert match, f"node {node}'s log has no line matching {pattern!r}: {outcome.describe()}"
+    return match
+
+
+def assert_figures(outcome: Outcome, node: str, *names: str) -> None:
+    for name in names:
+        path = outcome.artifact(node, name)
+        assert path.is_file(), f"figure {name} did not come back: {outcome.describe()}"
+        assert png_size(path) == FIGURE_PX, name
+
+
+def node_messages(outcome: Outcome, topic: str, node: str) -> int:
+    entry = outcome.graph.get(topic)
+    assert entry is not None, f"no topic {topic} in the run's graph: {sorted(outcome.graph)}"
+    assert node in entry["publishers"], entry
+    return entry["messages"]
+
+
+# ------------------------------------------------------------------------------------ checks
+def check_talker_listener(outcome: Outcome) -> None:
+    heard = re.findall(r"/listener\S* I heard hello world (\d+\.?\d*)", outcome.log("listener"))
+    assert len(heard) >= 20, outcome.describe()
+    # The talker stamps each line with rospy.get_time(): the listener hears them in order.
+    stamps = [float(value) for value in heard]
+    assert stamps == sorted(stamps) and stamps[-1] - stamps[0] >= 2.0
+    chatter = outcome.messages("chatter")
+    assert 25 <= len(chatter) <= 32, len(chatter)  # 10 Hz for 3 s
+    assert chatter[0][1].data.startswith("hello world ")
+    entry = outcome.graph["chatter"]
+    assert entry["publishers"] == ["talker"] and entry["subscribers"] == ["listener"]
+
+
+def check_class_approach(outcome: Outcome) -> None:
+    assert sensor_distance(outcome.end.x) == pytest.approx(0.30, abs=0.03)
+    assert outcome.metrics["run"]["collisions"] == 0
+    assert node_messages(outcome, "Control", "class_approach") >= 70  # 10 Hz for 8 s
+
+
+def check_busy_approach(outcome: Outcome) -> None:
+    # Forward at 0.1 m/s until the sensor reads 25 cm or less: the loop never sleeps, yet its
+    # callback keeps updating the distance and time keeps going.
+    assert sensor_distance(outcome.end.x) == pytest.approx(0.25, abs=0.03)
+    assert outcome.travelled_between(0.0, 2.0) == pytest.approx(0.2, abs=0.04)
+    assert_still_after(outcome, outcome.end.t - 1.0)
+    assert outcome.metrics["run"]["collisions"] == 0
+
+
+def check_wall_follower(outcome: Outcome) -> None:
+    assert outcome.end.x - outcome.start.x >= 0.5, outcome.end
+    for pose in outcome.poses:
+        assert 2.75 <= pose.y <= 3.25, pose  # kept off the south wall (y = 2.5)
+    assert outcome.metrics["run"]["collisions"] == 0
+
+
+def check_square(outcome: Outcome) -> None:
+    start, end = outcome.start, outcome.end
+    farthest = max(math.hypot(p.x - start.x, p.y - start.y) for p in outcome.poses)
+    assert 0.25 <= farthest <= 0.5, farthest  # a 0.3 m square's diagonal is 0.42 m
+    assert math.hypot(end.x - start.x, end.y - start.y) < 0.15, end
+    assert outcome.turned() == pytest.approx(2 * math.pi, abs=0.6)
+    assert_log(outcome, "square_time_now", r"side 4")
+    assert_log(outcome, "square_time_now", r"square done")
+
+
+def check_timer(outcome: Outcome) -> None:
+    assert outcome.travelled_between(0.0, 2.2) == pytest.approx(0.2, abs=0.04)
+    assert_still_after(outcome, 2.4)
+    ticks = int(assert_log(outcome, "timer_driver", r"stopped after (\d+) ticks").group(1))
+    assert 18 <= ticks <= 21
+    period = float(assert_log(outcome, "timer_driver", r"timer period (\d\.\d+) s").group(1))
+    assert period == pytest.approx(0.1, abs=0.02)
+
+
+def check_services(outcome: Outcome) -> None:
+    assert_log(outcome, "motor_client", r"server says: motors on")
+    distance_cm = int(assert_log(outcome, "motor_client", r"distance now (\d+) cm").group(1))
+    assert 33 <= distance_cm <= 47  # 0.6 m at the start, minus 2 s at 0.1 m/s
+    assert_log(outcome, "motor_client", r"server says: motors off")
+    assert_log(outcome, "motor_server", r"enable_motors\(True\)")
+    assert_log(outcome, "motor_server", r"enable_motors\(False\)")
+    assert outcome.travelled_between(0.0, outcome.end.t) == pytest.approx(0.2, abs=0.05)
+    assert_still_after(outcome, 3.0)
+    assert any(message.data for _, message in outcome.messages("Buzzer")), "beep never beeped"
+
+
+def check_params_default(outcome: Outcome) -> None:
+    assert_log(outcome, "param_driver", r"unnamed robot: speed 0\.05 m/s, stop at 0\.25 m")
+    assert outcome.travelled_between(0.0, 3.0) == pytest.approx(0.15, abs=0.03)
+
+
+def check_params_set(outcome: Outcome) -> None:
+    assert_log(outcome, "param_driver", r"crowbot_7: speed 0\.10 m/s, stop at 0\.25 m")
+    assert outcome.travelled_between(0.0, 3.0) == pytest.approx(0.30, abs=0.04)
+
+
+def check_rosrun_args(outcome: Outcome) -> None:
+    # _speed:=0.1 _stop_distance:=0.45 set the private parameters and leave argv clean.
+    assert_log(outcome, "param_driver", r"speed 0\.10 m/s, stop at 0\.45 m")
+    assert_log(outcome, "param_driver", r"extra arguments: \[\]")
+    assert sensor_distance(outcome.end.x) == pytest.approx(0.45, abs=0.03)
+    assert_still_after(outcome, outcome.end.t - 1.0)
+
+
+def check_remap(outcome: Outcome) -> None:
+    assert_log(outcome, "remap_forward", r"publishing on /Control")
+    assert outcome.travelled_between(0.0, outcome.end.t) == pytest.approx(0.2, abs=0.04)
+    assert node_messages(outcome, "Control", "remap_forward") >= 35  # 20 Hz for 2 s
+    assert "cmd_vel" not in outcome.recording
+
+
+def check_odom_turn(outcome: Outcome) -> None:
+    assert angle_between(outcome.end.yaw, outcome.start.yaw) == pytest.approx(
+        math.pi / 2, abs=math.radians(6)
+    )
+    assert outcome.travelled_between(0.0, outcome.end.t) < 0.05
+    assert_log(outcome, "odom_turn_tf", r"reached yaw")
+
+
+def check_tf2_distance(outcome: Outcome) -> None:
+    assert outcome.travelled_between(0.0, outcome.end.t) == pytest.approx(0.3, abs=0.05)
+    assert_still_after(outcome, outcome.end.t - 1.0)
+    assert_log(outcome, "tf2_distance", r"travelled 0\.3\d m")
+
+
+def check_tf_listener(outcome: Outcome) -> None:
+    assert outcome.travelled_between(0.0, outcome.end.t) == pytest.approx(0.4, abs=0.06)
+    assert_still_after(outcome, outcome.end.t - 1.0)
+    assert_log(outcome, "tf_listener_drive", r"travelled 0\.4\d m, yaw 9\d\.\d deg")
+
+
+def check_shutdown_hook(outcome: Outcome) -> None:
+    # Driving at 0.1 m/s for 1.5 s, then the hook's zero Twist stops the robot at once; the
+    # monitor keeps the run going, so without the hook the robot would keep its last command.
+    assert outcome.travelled_between(0.0, 1.6) == pytest.approx(0.15, abs=0.03)
+    assert_still_after(outcome, 1.8)
+    assert_log(outcome, "shutdown_stop", r"stopping the robot")
+    seen = re.findall(r"cmd linear (-?\d\.\d\d)", outcome.log("cmd_monitor"))
+    assert seen.count("0.10") >= 13 and seen[-1] == "0.00", seen
+
+
+def check_wait_for_scan(outcome: Outcome) -> None:
+    match = assert_log(outcome, "wait_for_scan", r"first scan after (\d+\.\d+) s with (\d+) beams")
+    assert float(match.group(1)) < 0.2  # the scan comes at 15 Hz: no waiting out the timeout
+    first_scan = outcome.messages("scan")[0][1]
+    assert int(match.group(2)) == len(first_scan.ranges)
+    assert outcome.travelled_between(0.0, outcome.end.t) >= 0.4
+
+
+def check_crowbot_pid(outcome: Outcome) -> None:
+    assert sensor_distance(outcome.end.x) == pytest.approx(0.20, abs=0.03)
+    assert outcome.metrics["run"]["collisions"] == 0
+    assert_figures(outcome, "crowbot_pid", "pid_error.png", "pid_control.png")
+
+
+def check_crowbot_light(outcome: Outcome) -> None:
+    heading_to_lamp = math.pi / 2
+    assert angle_between(outcome.end.yaw, outcome.start.yaw) == pytest.approx(
+        heading_to_lamp, abs=math.radians(20)
+    )
+    assert_figures(outcome, "crowbot_light", "light_error.png", "light_control.png")
+
+
+def check_tb3_obstacle_stop(outcome: Outcome) -> None:
+    north_wall_y = 3.7  # [m]
+    assert north_wall_y - outcome.end.y == pytest.approx(0.35, abs=0.06)
+    assert_still_after(outcome, outcome.end.t - 1.0)
+    assert_log(outcome, "tb3_obstacle_stop", r"Stop! obstacle at 0\.3\d m")
+
+
+def check_tb3_closest(outcome: Outcome) -> None:
+    # At (3.0, 2.9) the south wall is 0.4 m away, the north wall 0.8 m: it turns to face south.
+    assert outcome.end.yaw == pytest.approx(-math.pi / 2, abs=math.radians(10))
+    assert outcome.travelled_between(0.0, outcome.end.t) < 0.05
+
+
+def check_debug_topic(outcome: Outcome) -> None:
+    errors = [message.data for _, message in outcome.messages("debug/error")]
+    assert len(errors) >= 50, len(errors)
+    assert errors[0] == pytest.approx(0.3, abs=0.02) and abs(errors[-1]) < 0.03
+    assert outcome.graph["debug/error"]["subscribers"] == []
+    assert sensor_distance(outcome.end.x) == pytest.approx(0.30, abs=0.03)
+
+
+def check_launch(outcome: Outcome) -> None:
+    driver = next((name for name in outcome.logs if name.endswith("driver")), "driver")
+    assert_log(outcome, driver, r"crowbot_lab_3: speed 0\.10, stop at 0\.30 m, kp 0\.80")
+    assert sensor_distance(outcome.end.x) == pytest.approx(0.30, abs=0.03)
+    too_close = [message.data for _, message in outcome.messages("monitor/too_close")]
+    assert too_close and not too_close[0] and too_close[-1], too_close[:3] + too_close[-3:]
+
+
+def check_waypoints(outcome: Outcome) -> None:
+    # 0.3 m ahead (+y), a 1.5 rad left turn, 0.3 m ahead again.
+    start, end = outcome.start, outcome.end
+    assert angle_between(end.yaw, start.yaw) == pytest.approx(1.5, abs=0.2)
+    heading = start.yaw + 1.5
+    expected_x = start.x + 0.3 * math.cos(start.yaw) + 0.3 * math.cos(heading)
+    expected_y = start.y + 0.3 * math.sin(start.yaw) + 0.3 * math.sin(heading)
+    assert math.hypot(end.x - expected_x, end.y - expected_y) < 0.1, (end, expected_x, expected_y)
+    assert_log(outcome, "waypoint_driver", r"loaded 3 segments")
+    trajectory = outcome.artifact("waypoint_driver", "trajectory.csv")
+    assert trajectory.is_file(), outcome.describe()
+    rows = list(csv.DictReader(io.StringIO(trajectory.read_text())))
+    assert len(rows) >= 60  # 20 Hz for 4.5 s
+    times = [float(row["t"]) for row in rows]
+    assert times == sorted(times) and times[-1] - times[0] >= 4.0
+
+
+def check_yaml_config(outcome: Outcome) -> None:
+    assert_log(outcome, "yaml_config_approach", r"'setpoint_m': 0\.35")
+    assert sensor_distance(outcome.end.x) == pytest.approx(0.35, abs=0.03)
+
+
+def check_roslib_open_loop(outcome: Outcome) -> None:
+    assert outcome.travelled_between(0.0, outcome.end.t) == pytest.approx(0.2, abs=0.04)
+    assert_still_after(outcome, 2.8)
+    assert_log(outcome, "roslib_open_loop", r"open loop move done")
+
+
+def check_ir_scout_commands(outcome: Outcome) -> None:
+    assert outcome.travelled_between(0.0, 2.1) == pytest.approx(0.24, abs=0.04)
+    assert angle_between(outcome.end.yaw, outcome.start.yaw) == pytest.approx(1.5, abs=0.3)
+    assert_still_after(outcome, 3.3)
+    assert_log(outcome, "ir_scout_commands", r"sequence finished at t=3\.\d")
+
+
+def check_reactive(outcome: Outcome) -> None:
+    assert sensor_distance(outcome.end.x) == pytest.approx(0.35, abs=0.02)
+    # One command per Distance reading: messages flow robot -> node -> robot at 20 Hz.
+    distance = outcome.graph["Distance"]["messages"]
+    assert node_messages(outcome, "Control", "reactive_callback") >= 0.9 * distance
+
+
+# ------------------------------------------------------------------------------------- cases
+@dataclass(frozen=True)
+class Case:
+    """One corpus run: its scripts (or launch file), where it runs and what it must do."""
+
+    id: str
+    robot: str
+    world: str
+    duration_s: float
+    check: Callable[[Outcome], None]
+    nodes: tuple[Node, ...] = ()
+    launch: str | None = None
+    spawn: str | None = None
+    initial_pose: tuple[float, float, float] | None = None  # x [m], y [m], yaw [rad]
+    files: tuple[str, ...] = ()  # workspace data files the scripts read
+    clocks: tuple[Clock, ...] = (Clock.LOCKSTEP, Clock.REALTIME)
+    needs: tuple[str, ...] = field(default=())  # features not on main yet: strict xfail
+
+
+CASES = (
+    Case(
+        "talker_listener",
+        "crowbot",
+        "wall_approach",
+        3.0,
+        check_talker_listener,
+        nodes=(Node("talker.py"), Node("listener.py")),
+        needs=("Publisher created before init_node (issue 12, 1)",),
+    ),
+    Case(
+        "class_approach",
+        "crowbot",
+        "wall_approach",
+        8.0,
+        check_class_approach,
+        nodes=(Node("class_approach.py"),),
+    ),
+    Case(
+        "busy_approach",
+        "crowbot",
+        "wall_approach",
+        5.0,
+        check_busy_approach,
+        nodes=(Node("busy_approach.py"),),
+        needs=("time advancing in a loop that never sleeps (issue 12, 2)",),
+    ),
+    Case(
+        "tb3_wall_follower",
+        "turtlebot3",
+        "office",
+        6.0,
+        check_wall_follower,
+        nodes=(Node("tb3_wall_follower.py"),),
+        initial_pose=(2.6, 2.95, 0.0),
+        needs=("the turtlebot3 robot", "time advancing in a loop that never sleeps (issue 12, 2)"),
+    ),
+    Case(
+        "square_time_now",
+        "turtlebot",
+        "office",
+        9.0,
+        check_square,
+        nodes=(Node("square_time_now.py"),),
+        spawn="start",
+        needs=("time advancing in a loop that never sleeps (issue 12, 2)",),
+    ),
+    Case(
+        "timer_driver",
+        "crowbot",
+        "wall_approach",
+        3.5,
+        check_timer,
+        nodes=(Node("timer_driver.py"),),
+        needs=("rospy.Timer",),
+    ),
+    Case(
+        "services",
+        "crowbot",
+        "wall_approach",
+        4.0,
+        check_services,
+        nodes=(Node("motor_server.py"), Node("motor_client.py")),
+        needs=("std_srvs and rospy services",),
+    ),
+    Case(
+        "params_default",
+        "crowbot",
+        "wall_approach",
+        3.0,
+        check_params_default,
+        nodes=(Node("param_driver.py"),),
+    ),
+    Case(
+        "params_set",
+        "crowbot",
+        "wall_approach",
+        3.0,
+        check_params_set,
+        nodes=(Node("param_driver.py", params={"~speed": 0.1, "/robot_name": "crowbot_7"}),),
+        needs=("per-node parameters (NodeSpec.params)",),
+    ),
+    Case(
+        "rosrun_args",
+        "crowbot",
+        "wall_approach",
+        3.5,
+        check_rosrun_args,
+        nodes=(Node("param_driver.py", args=("_speed:=0.1", "_stop_distance:=0.45")),),
+        needs=("rosrun arguments (NodeSpec.args)",),
+    ),
+    Case(
+        "remap",
+        "crowbot",
+        "wall_approach",
+        3.0,
+        check_remap,
+        nodes=(Node("remap_forward.py", remaps=(("cmd_vel", "Control"),)),),
+        needs=("remappings (NodeSpec.remaps)", "rospy.resolve_name"),
+    ),
+    Case(
+        "odom_turn_tf",
+        "turtlebot",
+        "office",
+        5.0,
+        check_odom_turn,
+        nodes=(Node("odom_turn_tf.py"),),
+        spawn="start",
+        needs=("the tf module (tf.transformations)",),
+    ),
+    Case(
+        "tf2_distance",
+        "turtlebot3",
+        "office",
+        5.0,
+        check_tf2_distance,
+        nodes=(Node("tf2_distance.py"),),
+        spawn="start",
+        needs=("the turtlebot3 robot", "tf2_ros"),
+    ),
+    Case(
+        "tf_listener_drive",
+        "turtlebot",
+        "office",
+        4.0,
+        check_tf_listener,
+        nodes=(Node("tf_listener_drive.py"),),
+        spawn="start",
+        needs=("the tf module (tf.TransformListener)",),
+    ),
+    Case(
+        "shutdown_hook",
+        "crowbot",
+        "wall_approach",
+        3.0,
+        check_shutdown_hook,
+        nodes=(Node("shutdown_stop.py"), Node("cmd_monitor.py")),
+        needs=("publish() inside on_shutdown hooks (issue 12, 5)",),
+    ),
+    Case(
+        "wait_for_scan",
+        "turtlebot",
+        "office",
+        3.0,
+        check_wait_for_scan,
+        nodes=(Node("wait_for_scan.py"),),
+        spawn="start",
+        needs=("wait_for_message returning the first message (issue 12, 6)",),
+    ),
+    Case(
+        "crowbot_pid",
+        "crowbot",
+        "wall_approach",
+        9.0,
+        check_crowbot_pid,
+        nodes=(Node("crowbot_pid.py"),),
+        needs=("Publisher created before init_node (issue 12, 1)",),
+    ),
+    Case(
+        "crowbot_light",
+        "crowbot",
+        "light_arena",
+        6.0,
+        check_crowbot_light,
+        nodes=(Node("crowbot_light.py"),),
+        spawn="centre",
+        needs=("Publisher created before init_node (issue 12, 1)",),
+    ),
+    Case(
+        "tb3_obstacle_stop",
+        "turtlebot3",
+        "office",
+        6.0,
+        check_tb3_obstacle_stop,
+        nodes=(Node("tb3_obstacle_stop.py"),),
+        initial_pose=(2.6, 2.75, math.pi / 2),
+        needs=("the turtlebot3 robot",),
+    ),
+    Case(
+        "tb3_closest_obstacle",
+        "turtlebot3",
+        "office",
+        4.0,
+        check_tb3_closest,
+        nodes=(Node("tb3_closest_obstacle.py"),),
+        initial_pose=(3.0, 2.9, 0.0),
+        needs=("the turtlebot3 robot",),
+    ),
+    Case(
+        "debug_topic",
+        "crowbot",
+        "wall_approach",
+        6.0,
+        check_debug_topic,
+        nodes=(Node("debug_topic.py"),),
+        needs=("topics the robot does not have in a one-node run (issue 12, 3)",),
+    ),
+    Case(
+        "launch_file",
+        "crowbot",
+        "wall_approach",
+        6.0,
+        check_launch,
+        launch="approach.launch",
+        needs=("robodojo run --launch",),
+    ),
+    Case(
+        "waypoints_csv",
+        "turtlebot",
+        "office",
+        5.5,
+        check_waypoints,
+        nodes=(Node("waypoint_driver.py"),),
+        spawn="start",
+        files=("segments.csv",),
+        needs=("workspace data files (RunSpec.files)",),
+    ),
+    Case(
+        "yaml_config",
+        "crowbot",
+        "wall_approach",
+        6.0,
+        check_yaml_config,
+        nodes=(Node("yaml_config_approach.py"),),
+        files=("approach.yaml",),
+        needs=("workspace data files (RunSpec.files)",),
+    ),
+    Case(
+        "roslib_open_loop",
+        "ir_scout",
+        "wall_approach",
+        4.0,
+        check_roslib_open_loop,
+        nodes=(Node("roslib_open_loop.py"),),
+        needs=("the roslib module",),
+    ),
+    Case(
+        "ir_scout_commands",
+        "ir_scout",
+        "wall_approach",
+        4.0,
+        check_ir_scout_commands,
+        nodes=(Node("ir_scout_commands.py"),),
+    ),
+    Case(
+        "reactive_callback",
+        "crowbot",
+        "wall_approach",
+        6.0,
+        check_reactive,
+        nodes=(Node("reactive_callback.py"),),
+    ),
+)
+
+
+def _params():
+    # Every lockstep run first, then the realtime ones (which take their duration in wall time).
+    for clock in (Clock.LOCKSTEP, Clock.REALTIME):
+        for case in CASES:
+            if clock not in case.clocks:
+                continue
+            marks = []
+            if case.needs:
+                marks.append(
+                    pytest.mark.xfail(reason="needs " + ", ".join(case.needs), strict=True)
+                )
+            yield pytest.param(case, clock, id=f"{case.id}-{clock.value}", marks=marks)
+
+
+def run_case(case: Case, clock: Clock, launcher, out_dir) -> Outcome:
+    if case.launch:
+        return run_launch_file(
+            out_dir,
+            launch=case.launch,
+            robot=case.robot,
+            world=case.world,
+            clock=clock,
+            duration_s=case.duration_s,
+            spawn=case.spawn,
+        )
+    return run_scripts(
+        launcher,
+        out_dir,
+        robot=case.robot,
+        world=case.world,
+        nodes=case.nodes,
+        clock=clock,
+        duration_s=case.duration_s,
+        spawn=case.spawn,
+        initial_pose=case.initial_pose,
+        files=case.files,
+    )
+
+
+@pytest.mark.parametrize(("case", "clock"), list(_params()))
+def test_course_script_runs_unchanged(case: Case, clock: Clock, launcher, tmp_path) -> None:
+    outcome = run_case(case, clock, launcher, tmp_path / "run")
+    assert outcome.state == "finished", outcome.describe()
+    # A run ends at its duration, or earlier when every script has ended.
+    assert outcome.reason in FINISHED, outcome.describe()
+    for node, text in outcome.logs.items():
+        assert "Traceback" not in text, f"node {node} raised: {outcome.describe()}"
+    case.check(outcome)
+
+
+def test_the_corpus_is_large_enough_and_every_script_is_used() -> None:
+    scripts = {path.name for path in SCRIPTS.glob("*.py")}
+    used = {node.file for case in CASES for node in case.nodes}
+    assert len(scripts) >= 25
+    launched = {"launch_driver.py", "range_monitor.py"}  # named by approach.launch
+    assert scripts == used | launched, scripts ^ (used | launched)
+    for path in SCRIPTS.glob("*.py"):
+        comment = path.read_text().splitlines()[1]
+        assert comment.startswith("# Course pattern: "), path.name
