@@ -410,7 +410,6 @@ CASES = (
         check_odom_turn,
         nodes=(Node("odom_turn_tf.py"),),
         spawn="start",
-        needs=("the tf module (tf.transformations)",),
     ),
     Case(
         "tf2_distance",
