@@ -203,7 +203,9 @@ def _finish(
 
 def run_node(link: Link, load: Load, workdir: str, limits: Limits = DEFAULT_LIMITS) -> Exited:
     """Run the student's code to its end; return the Exited frame for the runner to send."""
-    node = NodeRuntime(link, load.info, NodeClock(load.info.clock, load.info.start_time_s))
+    node = NodeRuntime(
+        link, load.info, NodeClock(load.info.clock, load.info.start_time_s), load.filename
+    )
     register_source(load.filename, load.code)
     error: BaseException | None = None
     inputs = write_workspace_files(workdir, load.files)

@@ -31,8 +31,10 @@ from sandbox.protocol import (
     Artifact,
     Envelope,
     Exited,
+    Finishing,
     FrameReader,
     FrameWriter,
+    GraphTopic,
     Load,
     NodeInfo,
     Outcome,
@@ -53,13 +55,15 @@ class NodeState(StrEnum):
     IDLE = "idle"  # Ready received, waiting in the pool for code
     RUNNING = "running"  # woken (or loaded), computing until it yields
     SLEEPING = "sleeping"  # yielded, waiting for the next wake
+    FINISHING = "finishing"  # ended its part in the run; hooks, figures and files to come
     EXITED = "exited"
 
 
 _TRANSITIONS = {
     NodeState.STARTING: {NodeState.IDLE, NodeState.EXITED},
     NodeState.IDLE: {NodeState.RUNNING, NodeState.EXITED},
-    NodeState.RUNNING: {NodeState.SLEEPING, NodeState.EXITED},
+    NodeState.RUNNING: {NodeState.SLEEPING, NodeState.FINISHING, NodeState.EXITED},
+    NodeState.FINISHING: {NodeState.EXITED},
     NodeState.SLEEPING: {NodeState.RUNNING, NodeState.EXITED},
     NodeState.EXITED: set(),
 }
@@ -191,23 +195,28 @@ class NodeProcess:
         self._expect(self.limits.first_step_budget_s, "first step")
         return self.poll_reply(None)
 
-    def wake(self, time_s: float, deliveries: list[Envelope]) -> Yield | Exited:
+    def wake(
+        self, time_s: float, deliveries: list[Envelope], graph: list[GraphTopic] | None = None
+    ) -> Yield | Finishing | Exited:
         """Wake the sleeping node at simulated (or wall) time `time_s` with new messages and
         wait for it to sleep again (or end)."""
-        self.begin_wake(time_s, deliveries)
+        self.begin_wake(time_s, deliveries, graph)
         return self.poll_reply(None)
 
-    def begin_wake(self, time_s: float, deliveries: list[Envelope]) -> None:
+    def begin_wake(
+        self, time_s: float, deliveries: list[Envelope], graph: list[GraphTopic] | None = None
+    ) -> None:
         """Wake the node without waiting; collect its reply with `poll_reply` (a realtime run
-        drives several nodes at once this way)."""
+        drives several nodes at once this way). `graph`: the run's topics, if they changed."""
         self.time_s = time_s
         self._move(NodeState.RUNNING)
-        self._send(Wake(time_s=time_s, deliveries=deliveries))
+        self._send(Wake(time_s=time_s, deliveries=deliveries, graph=graph))
         self._expect(self.limits.step_budget_s, "step")
 
-    def poll_reply(self, timeout_s: float | None) -> Yield | Exited | None:
+    def poll_reply(self, timeout_s: float | None) -> Yield | Finishing | Exited | None:
         """The running node's reply, waiting at most `timeout_s` (None: until its budget runs
-        out). None means it is still computing within its budget."""
+        out). None means it is still computing within its budget. After a Finishing the node
+        has the end budget (limits.shutdown_budget_s) for its Exited: see `poll_finished`."""
         if self.state is not NodeState.RUNNING:
             raise NodeUsageError(f"node {self.name} is {self.state}, not waiting for a reply")
         until = (
@@ -218,6 +227,10 @@ class NodeProcess:
         reply = self._receive_until(until)
         if isinstance(reply, Yield):
             self._move(NodeState.SLEEPING)
+            return reply
+        if isinstance(reply, Finishing):
+            self._move(NodeState.FINISHING)
+            self._expect(self.limits.shutdown_budget_s, "end")
             return reply
         if isinstance(reply, Exited):
             self._finish(reply)
@@ -233,10 +246,38 @@ class NodeProcess:
         """The fds that become readable when the node replies or logs (for a caller's poll)."""
         return (self._fds[1], self._fds[2]) if self._fds else ()
 
+    def poll_finished(self, timeout_s: float = 0.0) -> Exited | None:
+        """A finishing node's Exited if it has come (reading what arrived so far), or its end
+        if it overran its end budget; None while it is still within it."""
+        if self.state is NodeState.EXITED:
+            return self.exited
+        if self.state is not NodeState.FINISHING:
+            raise NodeUsageError(f"node {self.name} is {self.state}, not finishing")
+        reply = self._receive_until(min(self._deadline, time.monotonic() + timeout_s))
+        if isinstance(reply, Exited):
+            self._finish(reply)
+            return reply
+        if self.state is NodeState.EXITED:
+            return self.exited
+        if reply is not None:
+            return self.kill(
+                f"node {self.name} sent {type(reply).__name__} after it finished",
+                Outcome.CRASHED,
+            )
+        if time.monotonic() >= self._deadline:
+            return self._overdue()
+        return None
+
     def shutdown(self, reason: str) -> Exited:
         """Ask the node to stop (on_shutdown hooks run, artifacts are collected)."""
         if self.state is NodeState.EXITED:
             return self.exited
+        if self.state is NodeState.FINISHING:
+            # A node that finished long ago may be blocked writing a large Exited: read it
+            # even when its end budget has passed meanwhile.
+            self._deadline = max(self._deadline, time.monotonic() + 1.0)
+            reply = self.poll_finished(self._deadline - time.monotonic())
+            return reply if reply is not None else self._overdue()
         if self.state is not NodeState.SLEEPING:
             return self.kill(f"stopped: {reason}", Outcome.SHUTDOWN)
         self._move(NodeState.RUNNING)
@@ -247,6 +288,8 @@ class NodeProcess:
             reply = self.kill(
                 f"stopped: {reason} (it kept running after shutdown)", Outcome.SHUTDOWN
             )
+        elif isinstance(reply, Finishing):
+            reply = self.shutdown(reason)
         return reply
 
     def kill(self, reason: str, outcome: Outcome = Outcome.KILLED) -> Exited:

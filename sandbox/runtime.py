@@ -5,22 +5,36 @@ shim (sandbox/ros_compat/rospy) and the step API (sandbox/step_api.py) are thin 
 and all state lives here, so the shim holds none of its own.
 
 A sleep is the only place the node talks to the parent: `wait_until()` sends a `Yield` with what
-was published since the last one, blocks for the next frame, and on `Wake` sets the clock and
-runs subscriber callbacks in delivery order (as rospy runs them inside sleep()/spin()); on
-`Shutdown` it runs the on_shutdown hooks and raises `ROSInterruptException`.
+was published since the last one, blocks for the next frame, and on `Wake` sets the clock, runs
+subscriber callbacks in delivery order and then the timers that fell due (rospy runs both on
+threads of their own; here they run inside the node's waits); on `Shutdown` it runs the
+on_shutdown hooks and raises `ROSInterruptException`.
+
+A node that never sleeps (`while not rospy.is_shutdown(): pub.publish(...)`) still sees time
+pass and callbacks run, as on a real robot: past `FREE_POLLS` calls of is_shutdown(),
+Time.now(), publish() and the clock functions since its last wake, each such call costs
+`POLL_COST_NS` of simulated time (lockstep), and every `BUSY_SLICE_NS` of it (realtime:
+`REALTIME_BUSY_SLICE_S` of wall time) the node yields as if it had slept. Counting calls, not
+measuring them, keeps lockstep runs reproducible.
 """
 
 from __future__ import annotations
 
+import contextlib
 import difflib
 import sys
+import time
+import traceback
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
 from sandbox.msgs import Message, get_message_class
 from sandbox.protocol import (
+    Clock,
     Envelope,
+    Finishing,
+    GraphTopic,
     NodeInfo,
     ProtocolError,
     Shutdown,
@@ -28,9 +42,19 @@ from sandbox.protocol import (
     Wake,
     Yield,
 )
+from sandbox.services import NodeServices
+from sandbox.timers import TimerSchedule
 from sandbox.vclock import NodeClock
 
+ANY_TYPE = "*"  # rospy.AnyMsg's type name
 WAKE_TOLERANCE_NS = 1_000  # [ns] a wake this close to the target counts as on time (float s)
+# The busy-loop model (module docstring). A rate loop makes a few polls per wake and never pays;
+# a loop that never sleeps makes thousands.
+FREE_POLLS = 100  # [calls] polls between two wakes that cost no time
+POLL_COST_NS = 20_000  # [ns] what one poll past the free ones costs: a rospy publish() or
+# is_shutdown() round on a laptop takes 10-50 us
+BUSY_SLICE_NS = 1_000_000  # [ns] lockstep: a busy node yields after this much polled time
+REALTIME_BUSY_SLICE_S = 0.01  # [s] realtime: a busy node yields after this much wall time
 
 
 # rospy's exception hierarchy (names and bases as in rospy.exceptions).
@@ -71,6 +95,7 @@ class Subscription:
     data_class: type[Message]
     callback: Callable[..., Any] | None
     callback_args: Any = None
+    queue_size: int | None = None  # [messages] a callback sees at most the newest this many
 
     def invoke(self, message: Message) -> None:
         if self.callback is None:
@@ -92,11 +117,11 @@ class NodeRuntime:
     link: Any  # sandbox.host.Link
     info: NodeInfo
     clock: NodeClock
+    filename: str = ""  # the student's file, as tracebacks name it
     node_name: str | None = None  # "/name" once init_node() ran (or the step API started)
     implicit_name: bool = False  # named by the step API; init_node() may rename it
     log_level: int = 2  # rospy.INFO
     params: dict[str, Any] = field(default_factory=dict)
-    outbox: list[Envelope] = field(default_factory=list)
     latest: dict[str, Envelope] = field(default_factory=dict)
     failure: BaseException | None = None
     log_sites: dict[tuple[Any, ...], int] = field(default_factory=dict)  # throttle/once state
@@ -111,12 +136,28 @@ class NodeRuntime:
     _subscribers: dict[str, list[Subscription]] = field(default_factory=dict)
     _hooks: list[Callable[[], Any]] = field(default_factory=list)
     _callback_depth: int = 0
+    _in_hooks: bool = False
+    _warned_names: set[str] = field(default_factory=set)
+    # The outbox keeps at most a publisher's queue_size messages per topic (oldest dropped, as
+    # rospy's publisher queue): entries are None once dropped.
+    _outbox_slots: list[Envelope | None] = field(default_factory=list)
+    _outbox_by_topic: dict[str, list[int]] = field(default_factory=dict)
+    _unsubscribed: list[str] = field(default_factory=list)
+    graph: list[GraphTopic] | None = None  # the run's topics, as of the last wake that sent it
+    timers: TimerSchedule = field(default_factory=TimerSchedule)
+    services: NodeServices = field(default_factory=NodeServices)
+    wake_topics: set[str] = field(default_factory=set)  # always wake early (service requests)
+    _polls: int = 0
+    _woken_ns: int = 0
+    _woken_wall_s: float = 0.0
 
     def __post_init__(self) -> None:
         for topic in self.info.robot_topics:
             self._robot[topic.name] = (topic.type, topic.direction)
             self._types[topic.name] = topic.type
         self.params = {normalize_param(key): value for key, value in self.info.params.items()}
+        self._woken_ns = self.clock.now_ns()
+        self._woken_wall_s = time.monotonic()
 
     # ------------------------------------------------------------------ state and contracts
     @property
@@ -130,25 +171,58 @@ class NodeRuntime:
                 "top of the script"
             )
 
+    def robot_direction(self, topic: str) -> str | None:
+        """ "publish" for the robot's sensor topics, "subscribe" for its command topics."""
+        entry = self._robot.get(topic)
+        return entry[1] if entry else None
+
     def sensor_topics(self) -> list[str]:
         return [name for name, (_, way) in self._robot.items() if way == "publish"]
 
     def command_topics(self) -> list[str]:
         return [name for name, (_, way) in self._robot.items() if way == "subscribe"]
 
+    def _close_robot_topic(self, name: str) -> str | None:
+        """One of the robot's topic names that `name` is probably a typo of, or None."""
+        by_lower = {topic.lower(): topic for topic in self._robot}
+        if name.lower() in by_lower:
+            return by_lower[name.lower()]
+        close = difflib.get_close_matches(name.lower(), list(by_lower), n=1, cutoff=0.8)
+        return by_lower[close[0]] if close else None
+
     def _unknown_topic(self, name: str) -> ROSException:
-        names = list(self._types)
-        by_lower = {topic.lower(): topic for topic in names}
-        close = difflib.get_close_matches(name.lower(), list(by_lower), n=1)
-        hint = f"did you mean '{by_lower[close[0]]}'? " if close else ""
+        close = self._close_robot_topic(name)
+        hint = f"did you mean '{close}'? " if close else ""
         return ROSException(
             f"unknown topic '{name}' on robot {self.info.robot}; {hint}its topics are "
             f"{', '.join(self.sensor_topics())} (sensors) and "
             f"{', '.join(self.command_topics())} (commands)"
         )
 
+    def _new_topic(self, name: str) -> None:
+        """A topic that is not the robot's: allowed, as in rospy; refused only where the run
+        says so; a name close to a robot topic gets a warning once (a typo is a dead topic)."""
+        if not self.info.allow_new_topics:
+            raise self._unknown_topic(name)
+        close = self._close_robot_topic(name)
+        if close is not None and name not in self._warned_names:
+            self._warned_names.add(name)
+            self.warn(
+                f"'{name}' is not one of the topics of robot {self.info.robot}; did you mean "
+                f"'{close}'? (a new topic '{name}' was made; the robot does not see it)"
+            )
+
     def _check_type(self, name: str, data_class: Any) -> str:
         type_name = getattr(data_class, "_type", None)
+        if type_name == ANY_TYPE and isinstance(data_class, type):  # rospy.AnyMsg
+            known = self._types.get(name)
+            if known is None:
+                raise ROSException(
+                    f"rospy.AnyMsg on '{name}' needs a topic whose type is known (one of the "
+                    "robot's or one this node publishes); subscribe with the message class, "
+                    "e.g. std_msgs.msg.String"
+                )
+            return known
         if not (isinstance(data_class, type) and issubclass(data_class, Message)):
             raise ROSException(
                 f"topic '{name}' needs a message class such as std_msgs.msg.Int32 as its type, "
@@ -172,9 +246,9 @@ class NodeRuntime:
                 f"'{name}' is published by the robot; command topics are "
                 f"{', '.join(self.command_topics())}"
             )
-        if name not in self._types and not self.info.allow_new_topics:
-            raise self._unknown_topic(name)
         type_name = self._check_type(name, data_class)
+        if name not in self._types:
+            self._new_topic(name)
         self._types[name] = type_name
         if name not in self._advertised:
             self._advertised.add(name)
@@ -184,23 +258,28 @@ class NodeRuntime:
         return name
 
     def subscribe(
-        self, topic: str, data_class: Any, callback: Callable[..., Any] | None, args: Any = None
+        self,
+        topic: str,
+        data_class: Any,
+        callback: Callable[..., Any] | None,
+        args: Any = None,
+        queue_size: int | None = None,
     ) -> Subscription:
         name = normalize_topic(topic)
+        type_name = self._check_type(name, data_class)
         if name not in self._types:
-            if not self.info.allow_new_topics:
-                raise self._unknown_topic(name)
-            self.warn(f"nothing is known to publish '{name}' yet; its callback may never run")
+            self._new_topic(name)
         elif (
             self._robot.get(name, ("", "publish"))[1] != "publish" and name not in self._advertised
         ):
             self.warn(f"'{name}' is a command topic the robot listens to; nothing publishes it")
-        type_name = self._check_type(name, data_class)
         self._types[name] = type_name
         if name not in self._subscribed:
             self._subscribed.add(name)
             self._new_subscribed.append(TopicDecl(name, type_name))
-        subscription = Subscription(name, data_class, callback, args)
+            if name in self._unsubscribed:
+                self._unsubscribed.remove(name)
+        subscription = Subscription(name, data_class, callback, args, queue_size)
         self._subscribers.setdefault(name, []).append(subscription)
         return subscription
 
@@ -208,31 +287,89 @@ class NodeRuntime:
         handlers = self._subscribers.get(subscription.topic, [])
         if subscription in handlers:
             handlers.remove(subscription)
+        if not handlers and subscription.topic in self._subscribed:
+            # Nothing here listens any more: the parent stops queueing the topic for us.
+            self._subscribed.discard(subscription.topic)
+            self._new_subscribed = [d for d in self._new_subscribed if d.name != subscription.topic]
+            self._unsubscribed.append(subscription.topic)
+            self._subscribers.pop(subscription.topic, None)
 
-    def publish(self, topic: str, message: Message) -> None:
-        """Queue `message` (already checked against the topic) for the next Yield."""
-        if self.shutdown is not None:
+    def publish(self, topic: str, message: Message, queue_size: int | None = None) -> None:
+        """Queue `message` (already checked against the topic) for the next Yield, keeping at
+        most `queue_size` of this topic's messages (None or 0: all of them)."""
+        if self.shutdown is not None and not self._in_hooks:
             raise ROSException(f"publish() on '{topic}' after shutdown ({self.shutdown.reason})")
         try:
             data = message.serialize()
         except Exception as error:
             raise ROSSerializationException(f"publish() on '{topic}': {error}") from None
-        self.outbox.append(Envelope(topic, message._type, data))
+        indexes = self._outbox_by_topic.get(topic)
+        if indexes is None:
+            indexes = self._outbox_by_topic[topic] = []
+        indexes.append(len(self._outbox_slots))
+        self._outbox_slots.append(Envelope(topic, message._type, data))
+        if queue_size and len(indexes) > queue_size:
+            self._outbox_slots[indexes.pop(0)] = None
+        self.poll()
 
     def topic_class(self, topic: str) -> type[Message]:
         return get_message_class(self._types[topic])
+
+    def topic_type(self, topic: str) -> str | None:
+        return self._types.get(topic)
+
+    # ------------------------------------------------------------------ busy loops
+    def poll(self) -> None:
+        """One call of a function a busy loop spins on (module docstring): past the free
+        polls it costs time, and now and then the node yields as if it slept."""
+        self._polls += 1
+        if self._polls <= FREE_POLLS or self._callback_depth or self.shutdown is not None:
+            return
+        if self.info.clock is Clock.LOCKSTEP:
+            self.clock.advance_ns(POLL_COST_NS)
+            if self.clock.now_ns() - self._woken_ns < BUSY_SLICE_NS:
+                return
+        elif time.monotonic() - self._woken_wall_s < REALTIME_BUSY_SLICE_S:
+            return
+        # The run may end meanwhile: is_shutdown() says so from now on.
+        with contextlib.suppress(ROSInterruptException):
+            self.wait_until(self.clock.now_ns())
 
     # ------------------------------------------------------------------ shutdown
     def on_shutdown(self, hook: Callable[[], Any]) -> None:
         self._hooks.append(hook)
 
     def signal_shutdown(self, reason: str, *, by_parent: bool = False) -> None:
+        """Shut the node down: hooks run first and may still publish (the usual zero Twist), as
+        rospy's on_shutdown hooks run before its topics close; an error in a hook is logged and
+        the next hook runs. Unless the parent asked, the parent is told the node is finishing,
+        so what it does next (figures, files) gets the end budget, not the step budget."""
         if self.shutdown is not None:
             return
         self.shutdown = _Shutdown(str(reason), by_parent)
         hooks, self._hooks = self._hooks, []
-        for hook in hooks:
-            self._run_student(hook)
+        self._in_hooks = True
+        try:
+            for hook in hooks:
+                self._run_hook(hook)
+        finally:
+            self._in_hooks = False
+        self.timers.clear()
+        if not by_parent:
+            try:
+                self.link.send(Finishing(reason=self.shutdown.reason, published=self.take_outbox()))
+            except ProtocolError as error:
+                raise LinkLost(error) from error
+
+    def _run_hook(self, hook: Callable[[], Any]) -> None:
+        self._callback_depth += 1
+        try:
+            hook()
+        except Exception as error:
+            self.log("ERROR", f"error in shutdown hook {_callable_name(hook)}: {error!r}")
+            print(_student_traceback(error, self.filename), file=sys.stderr, end="", flush=True)
+        finally:
+            self._callback_depth -= 1
 
     def _run_student(self, function: Callable[..., Any], *args: Any) -> None:
         """Call student code from inside a sleep; its exception ends the node."""
@@ -247,15 +384,34 @@ class NodeRuntime:
 
     # ------------------------------------------------------------------ sleeping
     def take_outbox(self) -> list[Envelope]:
-        sent, self.outbox = self.outbox, []
+        sent = [envelope for envelope in self._outbox_slots if envelope is not None]
+        self._outbox_slots, self._outbox_by_topic = [], {}
         return sent
 
-    def wait_until(self, wake_at_ns: int | None) -> None:
-        """One Yield and one frame from the parent: the node's only blocking point."""
+    def _effective_wake(
+        self, wake_at_ns: int | None, wake_on: list[str] | None
+    ) -> tuple[int | None, list[str] | None]:
+        """What to ask the parent for, with timers and services counted in."""
+        timer_ns = self.timers.next_due_ns()
+        if wake_at_ns is None and wake_on is None:  # spinning: any message wakes the node
+            if timer_ns is None:
+                return None, None
+            return timer_ns, sorted(self._subscribed)
+        topics = set(wake_on or ()) | self.wake_topics
+        if timer_ns is not None:
+            wake_at_ns = timer_ns if wake_at_ns is None else min(wake_at_ns, timer_ns)
+        return wake_at_ns, sorted(topics) if topics else None
+
+    def wait_until(self, wake_at_ns: int | None, wake_on: list[str] | None = None) -> None:
+        """One Yield and one frame from the parent: the node's only blocking point.
+
+        Wakes at `wake_at_ns`, or earlier when a message arrives on a topic of `wake_on`; both
+        None: when any message arrives (spin). Timers and service requests wake it too."""
         if self._callback_depth:
             raise ROSException(
-                "sleeping inside a subscriber callback or shutdown hook would stall every "
-                "other callback; keep callbacks short and sleep in the main loop"
+                "sleeping inside a subscriber callback, timer, service handler or shutdown hook "
+                "would stall every other callback; keep callbacks short and sleep in the main "
+                "loop"
             )
         if self.failure is not None:
             raise NodeFailure(self.failure)
@@ -263,13 +419,16 @@ class NodeRuntime:
             raise ROSInterruptException(f"ROS shutdown request: {self.shutdown.reason}")
         sys.stdout.flush()
         sys.stderr.flush()
+        wake_at_ns, wake_on = self._effective_wake(wake_at_ns, wake_on)
         frame = Yield(
             wake_at_s=None if wake_at_ns is None else wake_at_ns / 1e9,
             published=self.take_outbox(),
             advertised=self._new_advertised,
             subscribed=self._new_subscribed,
+            wake_on=wake_on,
+            unsubscribed=self._unsubscribed,
         )
-        self._new_advertised, self._new_subscribed = [], []
+        self._new_advertised, self._new_subscribed, self._unsubscribed = [], [], []
         try:
             self.link.send(frame)
             reply = self.link.receive()
@@ -281,7 +440,16 @@ class NodeRuntime:
         if not isinstance(reply, Wake):
             raise LinkLost(ProtocolError(f"expected Wake or Shutdown, got {type(reply).__name__}"))
         self.clock.wake(reply.time_s)
+        self._polls, self._woken_ns, self._woken_wall_s = 0, self.clock.now_ns(), time.monotonic()
+        if reply.graph is not None:
+            self.graph = reply.graph
         self._deliver(reply.deliveries)
+        if self.shutdown is None:
+            for timer in self.timers.take_due(self.clock.now_ns()):
+                if not timer.stopped:  # an earlier callback may have stopped it
+                    self._run_student(timer.fire, self.clock.now_ns())
+                if self.shutdown is not None:
+                    break
         if self.shutdown is not None:  # a callback called signal_shutdown()
             raise ROSInterruptException(f"ROS shutdown request: {self.shutdown.reason}")
 
@@ -296,16 +464,28 @@ class NodeRuntime:
         self.sleep_until(self.clock.now_ns() + max(0, round(seconds * 1e9)))
 
     def _deliver(self, deliveries: list[Envelope]) -> None:
+        counts: dict[str, int] = {}
+        for envelope in deliveries:
+            counts[envelope.topic] = counts.get(envelope.topic, 0) + 1
+        seen: dict[str, int] = {}
         for envelope in deliveries:
             topic = envelope.topic  # the parent sends clean names
             self.latest[topic] = envelope
+            seen[topic] = index = seen.get(topic, 0) + 1
+            newer = counts[topic] - index  # messages of this topic still to come in this wake
             decoded: dict[type, Message] = {}
             for subscription in list(self._subscribers.get(topic, ())):
                 if self.shutdown is not None:
                     return
                 if subscription.callback is None:
                     continue  # the step API reads `latest` instead
+                if subscription.queue_size and newer >= subscription.queue_size:
+                    continue  # rospy's subscriber queue: only the newest queue_size wait
                 data_class = subscription.data_class
+                if data_class._type == ANY_TYPE:  # rospy.AnyMsg: the bytes, undecoded
+                    message = data_class.from_envelope(envelope.data, envelope.type)
+                    self._run_student(subscription.invoke, message)
+                    continue
                 if data_class._type != envelope.type:
                     self.warn(
                         f"dropped a {envelope.type} on '{topic}': subscribed as {data_class._type}"
@@ -321,6 +501,20 @@ class NodeRuntime:
 
     def warn(self, text: str) -> None:
         self.log("WARN", text)
+
+
+def _callable_name(function: Any) -> str:
+    return getattr(function, "__qualname__", None) or repr(function)
+
+
+def _student_traceback(error: BaseException, filename: str) -> str:
+    """The traceback of an error in student code, cut to the student's frames."""
+    from sandbox.student_errors import from_exception
+
+    try:
+        return from_exception(error, filename).traceback
+    except Exception:
+        return "".join(traceback.format_exception(error))
 
 
 def format_log_line(level_name: str, time_s: float, text: str) -> str:

@@ -60,6 +60,11 @@ class NodeClock:
     def now_s(self) -> float:
         return self.now_ns() / 1e9
 
+    def advance_ns(self, duration_ns: int) -> None:
+        """Lockstep: let the node's own clock run on by `duration_ns` while it computes (the
+        busy-loop model of sandbox.runtime); the next wake is no earlier than that."""
+        self._anchor_ns = self.now_ns() + duration_ns
+
     def wake(self, time_s: float) -> None:
         self._anchor_ns = max(seconds_to_ns(time_s), self.now_ns())
         self._anchor_wall_ns = _real_monotonic_ns()

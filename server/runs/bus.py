@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections import deque
 from dataclasses import dataclass, field
 
-from sandbox.protocol import Envelope, TopicDecl
+from sandbox.protocol import Envelope, GraphTopic, TopicDecl
 
 QUEUE_SIZE = 100  # [messages] per topic per subscriber between two wakes
 RATE_WINDOW = 50  # [messages] recent arrival times kept per topic to measure its rate
@@ -50,6 +50,7 @@ class TopicBus:
         self.nodes: list[str] = []
         self._inboxes: dict[str, _Inbox] = {}
         self._seq = 0
+        self.version = 0  # bumped whenever a node, a publisher or a subscriber comes or goes
 
     # ----------------------------------------------------------------------------- graph
     def add_node(self, name: str) -> None:
@@ -61,10 +62,12 @@ class TopicBus:
         topic = self.topics.get(name)
         if topic is None:
             topic = self.topics[name] = _Topic(type_name)
+            self.version += 1
         elif topic.type != type_name:
             raise TopicTypeMismatch(f"topic '{name}' carries {topic.type}, not {type_name}")
-        if publisher is not None:
+        if publisher is not None and publisher not in topic.publishers:
             topic.publishers.add(publisher)
+            self.version += 1
 
     def declare(self, node: str, advertised: list[TopicDecl], subscribed: list[TopicDecl]) -> None:
         """Record what a node said it publishes and subscribes to (from its Yield)."""
@@ -74,6 +77,35 @@ class TopicBus:
             self.declare_topic(decl.name, decl.type)
             self.topics[decl.name].subscribers.add(node)
             self._inboxes[node].queues.setdefault(decl.name, deque(maxlen=QUEUE_SIZE))
+            self.version += 1
+
+    def unsubscribe(self, node: str, names: list[str]) -> None:
+        """The node stopped listening to `names`: nothing more is queued for it there."""
+        inbox = self._inboxes[node]
+        for name in names:
+            topic = self.topics.get(name)
+            if topic is not None:
+                topic.subscribers.discard(node)
+            queue = inbox.queues.pop(name, None)
+            if queue:
+                inbox.pending -= len(queue)
+            self.version += 1
+
+    def remove_node(self, node: str) -> None:
+        """A node ended: it no longer subscribes or publishes (services it served are gone)."""
+        if node not in self._inboxes:
+            return
+        self.unsubscribe(node, list(self._inboxes[node].queues))
+        for topic in self.topics.values():
+            topic.publishers.discard(node)
+        self.version += 1
+
+    def graph_topics(self) -> list[GraphTopic]:
+        """The graph as nodes see it (rospy.get_published_topics, services)."""
+        return [
+            GraphTopic(name, topic.type, sorted(topic.publishers), sorted(topic.subscribers))
+            for name, topic in sorted(self.topics.items())
+        ]
 
     # ----------------------------------------------------------------------------- traffic
     def publish(self, publisher: str, envelope: Envelope, time_s: float) -> None:
@@ -86,7 +118,9 @@ class TopicBus:
             raise TopicTypeMismatch(
                 f"topic '{envelope.topic}' carries {topic.type}, not {envelope.type}"
             )
-        topic.publishers.add(publisher)
+        if publisher not in topic.publishers:
+            topic.publishers.add(publisher)
+            self.version += 1
         topic.count += 1
         topic.recent.append(time_s)
         self._seq += 1
@@ -103,6 +137,13 @@ class TopicBus:
 
     def has_pending(self, node: str) -> bool:
         return self._inboxes[node].pending > 0
+
+    def has_pending_on(self, node: str, topics: frozenset[str]) -> bool:
+        """Is a message waiting for `node` on one of `topics`?"""
+        inbox = self._inboxes[node]
+        if not inbox.pending:
+            return False
+        return any(inbox.queues.get(name) for name in topics)
 
     def take(self, node: str) -> tuple[list[Envelope], float | None]:
         """Everything waiting for `node`, in arrival order, and the publication time of the

@@ -49,15 +49,7 @@ def run_lockstep(run: Run) -> None:
         now = run.time_ns
         if now >= run.duration_ns:
             return  # the run covers [0, duration): nothing wakes at its last instant
-        due = [
-            slot
-            for slot in order
-            if not slot.done
-            and (
-                (slot.wake_at_ns is not None and slot.wake_at_ns <= now)
-                or (slot.wake_at_ns is None and run.bus.has_pending(slot.name))
-            )
-        ]
+        due = [slot for slot in order if not slot.done and run.is_due(slot, now)]
         if due and rounds < MAX_ROUNDS_PER_INSTANT:
             rounds += 1
             for slot in due:
@@ -77,9 +69,9 @@ def _next_event_ns(run: Run) -> int:
     for slot in run.slots.values():
         if slot.done:
             continue
-        if slot.wake_at_ns is None:
+        if run.listens(slot):
             spinning = True
-        else:
+        if slot.wake_at_ns is not None:
             candidates.append(slot.wake_at_ns)
     if spinning:
         # A spinning node wakes on messages: stop where the robot next publishes.
@@ -118,10 +110,7 @@ class RealtimeDriver:
                     run.handle_reply(slot, reply)
             if slot.done:
                 continue
-            if slot.process.state == "sleeping" and (
-                (slot.wake_at_ns is not None and slot.wake_at_ns <= run.time_ns)
-                or (slot.wake_at_ns is None and run.bus.has_pending(slot.name))
-            ):
+            if slot.process.state == "sleeping" and run.is_due(slot, run.time_ns):
                 run.begin_wake(slot, run.time_ns)
         # Next: a sleeping node's wake time, the robot's next message, or an idle check; a
         # node still computing is not due (its reply makes its fds readable).

@@ -25,12 +25,14 @@ from sandbox.launcher import Launcher
 from sandbox.msgs import Time, get_message_class
 from sandbox.msgs.geometry_msgs import Point, Pose, PoseStamped, Quaternion
 from sandbox.msgs.std_msgs import Header
+from sandbox.msgs.tf2_msgs import TFMessage
 from sandbox.node_process import NodeProcess
 from sandbox.protocol import (
     Artifact,
     Clock,
     Envelope,
     Exited,
+    Finishing,
     NodeInfo,
     Outcome,
     RobotTopic,
@@ -55,6 +57,7 @@ log = logging.getLogger("robodojo.runs")
 
 NS = 1_000_000_000
 GOAL_TOPIC = "goal"  # RViz's "2D Nav Goal" idea: the run publishes the goal pose here
+TF_TOPIC = "tf"  # the transform tree, recorded and published to nodes (tf2_ros listens here)
 TF_PERIOD_NS = NS // 30  # [ns] /tf recorded at 30 Hz: smooth in Foxglove, small on disk
 MAP_MARGIN_M = 0.5  # [m] beyond the world's bounds by this much, the robot left the map
 LOG_LINES_KEPT = 2000  # per node in memory (the recording keeps them all)
@@ -67,7 +70,12 @@ class NodeSlot:
     spec: NodeSpec
     process: NodeProcess | None = None
     wake_at_ns: int | None = 0  # None: spinning (wake on messages)
+    # Topics whose messages wake the node before wake_at_ns (services, wait_for_message);
+    # None: only wake_at_ns, or any message while spinning.
+    wake_on: frozenset[str] | None = None
+    graph_version: int = -1  # the bus graph version this node was last sent
     done: bool = False
+    finishing: bool = False  # ended its part; its Exited (files, figures) is still to come
     exited: Exited | None = None
     last_wake_ns: int | None = None
     newest_sensor_s: float | None = None  # publication time of the newest robot message seen
@@ -171,7 +179,8 @@ class Run(RunControls, RunOutputs):
             self.recorder.add_topic(topic.name, topic.type_name)
         self.bus.declare_topic(GOAL_TOPIC, PoseStamped._type, RUN)
         self.recorder.add_topic(GOAL_TOPIC, PoseStamped._type)
-        self.recorder.add_topic("tf", "tf2_msgs/TFMessage")
+        self.bus.declare_topic(TF_TOPIC, TFMessage._type, RUN)
+        self.recorder.add_topic(TF_TOPIC, TFMessage._type)
         if spec.light_position is not None:
             movable = [light.name for light in self.sim.lights if light.movable]
             if movable:
@@ -228,7 +237,18 @@ class Run(RunControls, RunOutputs):
     def _finish(self, end_state: RunState, reason: str, wall_s: float) -> RunResult:
         self._command_zero()
         for slot in self.slots.values():
+            finishing = slot.finishing
             self._end_node(slot, reason)
+            late = slot.exited
+            if finishing and late is not None and end_state is RunState.FINISHED:
+                # What a node did after its control part (figures, files) can still fail it.
+                if late.outcome is Outcome.ERROR and late.error is not None:
+                    self._log_lines(slot, late.error.traceback.rstrip("\n").split("\n"))
+                    where = f" at line {late.error.line}" if late.error.line else ""
+                    end_state = RunState.FAILED
+                    reason = f"failed: node {slot.name} raised {late.error.type}{where}"
+                elif late.outcome in (Outcome.KILLED, Outcome.CRASHED):
+                    end_state, reason = RunState.FAILED, f"failed: {late.reason}"
         if self.recorder is not None:
             metrics = self.metrics()
             self.recorder.write_json("metrics", metrics)
@@ -291,19 +311,33 @@ class Run(RunControls, RunOutputs):
         return {"run": run, "nodes": nodes}
 
     # ----------------------------------------------------------------------------- routing
-    def handle_reply(self, slot: NodeSlot, reply: Yield | Exited, timed: bool = True) -> None:
+    def handle_reply(
+        self, slot: NodeSlot, reply: Yield | Finishing | Exited, timed: bool = True
+    ) -> None:
         """Act on what a node said when it went back to sleep (or ended). `timed`: the reply
         answers a wake, so its wall time is a step's compute time (not start-up)."""
-        if timed:
+        if timed and not slot.finishing:
             slot.metrics.compute.add(time.perf_counter() - slot.woken_at_wall)
         self._collect_logs(slot)
         if isinstance(reply, Yield):
             self.bus.declare(slot.name, reply.advertised, reply.subscribed)
+            if reply.unsubscribed:
+                self.bus.unsubscribe(slot.name, reply.unsubscribed)
             self._from_node(slot, reply.published)
             slot.wake_at_ns = None if reply.wake_at_s is None else round(reply.wake_at_s * NS)
+            slot.wake_on = None if reply.wake_on is None else frozenset(reply.wake_on)
             return
         self._from_node(slot, reply.published)
-        slot.exited, slot.done = reply, True
+        self.bus.remove_node(slot.name)
+        if isinstance(reply, Finishing):
+            # The node's part in the run is over (its hooks' last messages are routed above);
+            # its figures and files come with its Exited, within the end budget.
+            slot.done, slot.finishing = True, True
+            self._log_lines(slot, [f"[run] node finishing: {reply.reason}"])
+            if all(s.done for s in self.slots.values()):
+                raise RunEnd(RunState.FINISHED, "finished: every node ended")
+            return
+        slot.exited, slot.done, slot.finishing = reply, True, False
         if reply.error is not None:  # the student's traceback belongs in the node's log
             lines = reply.error.traceback.rstrip("\n").split("\n")
             self._log_lines(slot, lines)
@@ -317,6 +351,28 @@ class Run(RunControls, RunOutputs):
                 RunState.FAILED, f"failed: node {slot.name} raised {reply.error.type}{where}"
             )
         raise RunEnd(RunState.FAILED, f"failed: {reply.reason}")
+
+    def is_due(self, slot: NodeSlot, now_ns: int) -> bool:
+        """Is the sleeping node to be woken at `now_ns`: its time has come, or a message it
+        waits for (any, while spinning; or one of its wake_on topics) is there."""
+        if slot.wake_at_ns is not None and slot.wake_at_ns <= now_ns:
+            return True
+        if slot.wake_on is None:
+            return slot.wake_at_ns is None and self.bus.has_pending(slot.name)
+        return self.bus.has_pending_on(slot.name, slot.wake_on)
+
+    def listens(self, slot: NodeSlot) -> bool:
+        """Can a message wake this node before its wake time (so the clock must stop at the
+        robot's next publication)?"""
+        return slot.wake_at_ns is None or slot.wake_on is not None
+
+    def poll_finishing(self) -> None:
+        """Collect the Exited of nodes that are finishing (or end them past their budget)."""
+        for slot in self.slots.values():
+            if slot.finishing and slot.process is not None:
+                exited = slot.process.poll_finished()
+                if exited is not None:
+                    self.handle_reply(slot, exited)
 
     def wake(self, slot: NodeSlot, time_ns: int) -> None:
         """Lockstep: wake one node now and handle its reply."""
@@ -332,7 +388,10 @@ class Run(RunControls, RunOutputs):
         slot.last_wake_ns = time_ns
         slot.metrics.wakes += 1
         slot.woken_at_wall = time.perf_counter()
-        slot.process.begin_wake(time_ns / NS, deliveries)
+        graph = None
+        if slot.graph_version != self.bus.version:
+            graph, slot.graph_version = self.bus.graph_topics(), self.bus.version
+        slot.process.begin_wake(time_ns / NS, deliveries, graph)
 
     def _from_node(self, slot: NodeSlot, published: list[Envelope]) -> None:
         now_s = self.time_ns / NS
@@ -447,6 +506,8 @@ class Run(RunControls, RunOutputs):
             self._apply_control(action, value)
         if self.builtins:
             self.builtins.tick(self)
+        if self._finishing_nodes():
+            self.poll_finishing()
         if self.backend is not None:
             self._emit_logs("robot", self.backend.take_logs())  # the robot's own loginfo
         self._check_robot()
@@ -454,6 +515,9 @@ class Run(RunControls, RunOutputs):
             self._record_tf()
         if self.recorder.error:
             raise RunEnd(RunState.FAILED, f"failed: {self.recorder.error}")
+
+    def _finishing_nodes(self) -> bool:
+        return any(slot.finishing for slot in self.slots.values())
 
     def next_script_ns(self) -> int | None:
         """Run time of the next scripted control, if any (the clocks stop there)."""
@@ -480,5 +544,8 @@ class Run(RunControls, RunOutputs):
             self.sim.robot.sensor_frames(self.sim.state),
             odom_origin=(origin.x, origin.y, origin.yaw),
         )
-        self.record("tf", message._type, self.time_ns, message.serialize())
+        data = message.serialize()
+        self.record(TF_TOPIC, message._type, self.time_ns, data)
+        # Nodes see the same tree on "tf" (tf2_ros.TransformListener subscribes to it).
+        self.bus.publish(RUN, Envelope(TF_TOPIC, message._type, data), self.time_ns / NS)
         self._next_tf_ns = self.time_ns + TF_PERIOD_NS

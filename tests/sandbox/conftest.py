@@ -12,7 +12,7 @@ import pytest
 from sandbox import bwrap
 from sandbox.launcher import Launcher
 from sandbox.limits import DEFAULT_LIMITS
-from sandbox.protocol import Api, Clock, Exited, NodeInfo, RobotTopic, Yield
+from sandbox.protocol import Api, Clock, Exited, Finishing, NodeInfo, RobotTopic, Yield
 
 # Short budgets so the attack tests that must be killed do not take long.
 TEST_LIMITS = dataclasses.replace(
@@ -58,5 +58,7 @@ def run_script(launcher: Launcher, code: str, name: str = "attack", api: Api = A
     """Load `code` as a node and return (first reply, node). The caller closes the node."""
     node = launcher.start(name)
     reply = node.load(code, f"{name}.py", api, crowbot_info(name))
+    if isinstance(reply, Finishing):  # the script ended: wait for its Exited (end budget)
+        reply = node.shutdown("script ended")
     assert isinstance(reply, (Yield, Exited))
     return reply, node

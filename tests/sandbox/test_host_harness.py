@@ -22,6 +22,7 @@ from sandbox.protocol import (
     Api,
     Envelope,
     Exited,
+    Finishing,
     Load,
     NodeInfo,
     Outcome,
@@ -80,6 +81,7 @@ class Parent:
         self._decoder = msgspec.msgpack.Decoder(ToParent)
         self._encoder = msgspec.msgpack.Encoder()
         self.crash: BaseException | None = None
+        self.finishing: Finishing | None = None
         load = Load(textwrap.dedent(code), filename, api, info or crowbot_info("student"))
 
         def child() -> None:
@@ -94,15 +96,27 @@ class Parent:
         self._thread.start()
 
     def next(self) -> Yield | Exited:
-        data = self.link.to_parent.get(timeout=TIMEOUT_S)
-        if data == b"":
-            assert self.crash is not None
-            raise self.crash
-        frame = self._decoder.decode(data)
-        assert isinstance(frame, Yield | Exited), frame
-        if isinstance(frame, Exited):
-            self._thread.join(TIMEOUT_S)
-        return frame
+        """The node's next Yield or its Exited; a Finishing on the way is kept in
+        `self.finishing` (what the node published last, e.g. from its shutdown hooks)."""
+        while True:
+            data = self.link.to_parent.get(timeout=TIMEOUT_S)
+            if data == b"":
+                assert self.crash is not None
+                raise self.crash
+            frame = self._decoder.decode(data)
+            if isinstance(frame, Finishing):
+                assert self.finishing is None, "a node finishes once"
+                self.finishing = frame
+                continue
+            assert isinstance(frame, Yield | Exited), frame
+            if isinstance(frame, Exited):
+                self._thread.join(TIMEOUT_S)
+            return frame
+
+    def last_published(self, exited: Exited) -> list[Envelope]:
+        """What the node published after its last sleep: with its Finishing and its Exited."""
+        before = self.finishing.published if self.finishing is not None else []
+        return [*before, *exited.published]
 
     def wake(self, time_s: float, deliveries: Iterable[Envelope] = ()) -> Yield | Exited:
         self.link.to_child.put(self._encoder.encode(Wake(time_s, list(deliveries))))
@@ -134,11 +148,15 @@ class Parent:
 
 
 def run(code: str, workdir: Path, **kwargs: object) -> tuple[list[Yield], Exited]:
-    return Parent(code, workdir, **kwargs).run_lockstep()  # type: ignore[arg-type]
+    """Run `code` to its end; the Exited's `published` is everything published after the last
+    sleep (the Finishing's messages, from shutdown hooks, then the Exited's own)."""
+    parent = Parent(code, workdir, **kwargs)  # type: ignore[arg-type]
+    yields, exited = parent.run_lockstep()
+    return yields, msgspec.structs.replace(exited, published=parent.last_published(exited))
 
 
-def test_a_script_that_never_sleeps_exits_with_what_it_published(tmp_path: Path) -> None:
-    yields, exited = run(
+def test_a_script_that_never_sleeps_finishes_with_what_it_published(tmp_path: Path) -> None:
+    parent = Parent(
         """
         import rospy
         from std_msgs.msg import Bool
@@ -147,9 +165,13 @@ def test_a_script_that_never_sleeps_exits_with_what_it_published(tmp_path: Path)
         """,
         tmp_path,
     )
+    yields, exited = parent.run_lockstep()
     assert yields == []
     assert exited.outcome is Outcome.FINISHED and exited.reason == "script ended"
-    assert [(e.topic, e.type) for e in exited.published] == [("Buzzer", "std_msgs/Bool")]
+    assert parent.finishing is not None and parent.finishing.reason == "script ended"
+    assert [(e.topic, e.type) for e in parent.finishing.published] == [
+        ("Buzzer", "std_msgs/Bool")
+    ]
 
 
 def test_a_broken_pipe_reaches_the_runner_as_protocol_error(tmp_path: Path) -> None:

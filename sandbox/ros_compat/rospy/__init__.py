@@ -13,7 +13,9 @@ from sandbox.runtime import (
     ROSInterruptException,
     ROSSerializationException,
 )
+from sandbox.timers import TimerEvent
 
+from . import exceptions
 from .core import (
     DEBUG,
     ERROR,
@@ -58,8 +60,16 @@ from .log import (
     logwarn_once,
     logwarn_throttle,
 )
+from .msg import AnyMsg
+from .services import Service, ServiceException, ServiceProxy, wait_for_service
 from .timing import Rate, Timer, get_rostime, get_time, sleep
-from .topics import Publisher, Subscriber, wait_for_message
+from .topics import (
+    Publisher,
+    SubscribeListener,
+    Subscriber,
+    get_published_topics,
+    wait_for_message,
+)
 
 __all__ = [
     "DEBUG",
@@ -67,6 +77,7 @@ __all__ = [
     "FATAL",
     "INFO",
     "WARN",
+    "AnyMsg",
     "Duration",
     "Publisher",
     "ROSException",
@@ -74,10 +85,16 @@ __all__ = [
     "ROSInterruptException",
     "ROSSerializationException",
     "Rate",
+    "Service",
+    "ServiceException",
+    "ServiceProxy",
+    "SubscribeListener",
     "Subscriber",
     "Time",
     "Timer",
+    "TimerEvent",
     "delete_param",
+    "exceptions",
     "get_caller_id",
     "get_name",
     "get_namespace",
@@ -85,6 +102,7 @@ __all__ = [
     "get_param",
     "get_param_cached",
     "get_param_names",
+    "get_published_topics",
     "get_rostime",
     "get_time",
     "has_param",
@@ -116,4 +134,33 @@ __all__ = [
     "sleep",
     "spin",
     "wait_for_message",
+    "wait_for_service",
 ]
+
+# Parts of rospy that talk to a ROS master or to other machines; each has a sentence that says
+# why it is absent and what to use instead.
+_NOT_PROVIDED = {
+    "get_master": "there is no ROS master in a RoboDojo run; rospy.get_published_topics() "
+    "lists the run's topics",
+    "Header": "use std_msgs.msg.Header",
+    "names": "use rospy.resolve_name() and rospy.get_name()",
+    "impl": "rospy's transport internals are not part of RoboDojo's rospy",
+    "wallsleep": "use rospy.sleep(): a run's time is the robot's time",
+    "get_rostime_wall": "use rospy.get_time()",
+}
+
+
+def __getattr__(name: str) -> object:
+    import difflib
+
+    reason = _NOT_PROVIDED.get(name)
+    if reason is not None:
+        raise AttributeError(f"rospy.{name} is not available in RoboDojo nodes: {reason}")
+    if name.startswith("__"):
+        raise AttributeError(name)
+    close = difflib.get_close_matches(name, __all__, n=2)
+    hint = f"did you mean {' or '.join('rospy.' + c for c in close)}? " if close else ""
+    raise AttributeError(
+        f"rospy has no '{name}' in RoboDojo: {hint}docs/controllers.md lists what RoboDojo's "
+        "rospy provides"
+    )

@@ -73,7 +73,9 @@ def myargv(argv: list[str] | None = None) -> list[str]:
 
 
 def is_shutdown() -> bool:
-    return _runtime.current().is_shutdown
+    node = _runtime.current()
+    node.poll()  # a loop that only polls this still lets time pass (sandbox.runtime)
+    return node.is_shutdown
 
 
 def is_shutdown_requested() -> bool:

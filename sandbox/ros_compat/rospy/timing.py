@@ -6,17 +6,20 @@ rospy.Time.now()` needs no conversion; this module gives `Time` its `now()`.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from numbers import Real
 from typing import Any
 
 from sandbox import runtime as _runtime
 from sandbox.msgs import Duration, Time
 from sandbox.runtime import ROSInterruptException
+from sandbox.timers import TimerEvent
 
 
 def _now(cls: type[Time] | None = None) -> Time:
     node = _runtime.current()
     node.require_init("rospy.Time.now()")
+    node.poll()
     return Time.from_nsec(node.clock.now_ns())
 
 
@@ -32,6 +35,7 @@ def get_time() -> float:
     """The node's time in seconds: simulated in lockstep runs, wall-clock-paced in realtime."""
     node = _runtime.current()
     node.require_init("rospy.get_time()")
+    node.poll()
     return node.clock.now_ns() / 1e9
 
 
@@ -88,10 +92,47 @@ class Rate:
 
 
 class Timer:
-    """Not available: a timer would need a thread; use a Rate loop or the step API."""
+    """Call `callback(event)` every `period` (a rospy.Duration or seconds) of node time, or
+    once with `oneshot=True`, as rospy.Timer does; callbacks run while the node sleeps, spins
+    or waits (sandbox/timers.py)."""
 
-    def __init__(self, *args: Any, **kwargs: Any) -> None:
-        raise _runtime.ROSException(
-            "rospy.Timer is not supported in RoboDojo nodes; use `rate = rospy.Rate(hz)` and "
-            "call your function in a `while not rospy.is_shutdown():` loop"
+    def __init__(
+        self,
+        period: Any,
+        callback: Callable[[TimerEvent], Any],
+        oneshot: bool = False,
+        reset: bool = False,
+    ) -> None:
+        node = _runtime.current()
+        node.require_init("rospy.Timer()")
+        if not callable(callback):
+            raise TypeError(
+                f"rospy.Timer(period, callback): callback must be a function, got {callback!r}"
+            )
+        period_ns = _duration_ns(period, "rospy.Timer()")
+        if period_ns <= 0:
+            raise ValueError(f"rospy.Timer() needs a positive period, got {period!r}")
+        self._period = Duration.from_nsec(period_ns)
+        self._callback = callback
+        self._oneshot = bool(oneshot)
+        self._scheduled = node.timers.add(period_ns, callback, self._oneshot, node.clock.now_ns())
+
+    def shutdown(self) -> None:
+        """Stop the timer; a callback already running finishes."""
+        self._scheduled.shutdown()
+
+    def is_alive(self) -> bool:
+        return not self._scheduled.stopped
+
+    def join(self, timeout: float | None = None) -> None:
+        """Wait (in node time) until the timer has stopped, as threading.Thread.join."""
+        node = _runtime.current()
+        step_ns = self._period.to_nsec()
+        deadline = (
+            None if timeout is None else node.clock.now_ns() + _duration_ns(timeout, "Timer.join()")
         )
+        while self.is_alive() and not node.is_shutdown:
+            if deadline is not None and node.clock.now_ns() >= deadline:
+                return
+            target = node.clock.now_ns() + step_ns
+            node.sleep_until(target if deadline is None else min(target, deadline))
