@@ -169,9 +169,7 @@ def test_a_script_that_never_sleeps_finishes_with_what_it_published(tmp_path: Pa
     assert yields == []
     assert exited.outcome is Outcome.FINISHED and exited.reason == "script ended"
     assert parent.finishing is not None and parent.finishing.reason == "script ended"
-    assert [(e.topic, e.type) for e in parent.finishing.published] == [
-        ("Buzzer", "std_msgs/Bool")
-    ]
+    assert [(e.topic, e.type) for e in parent.finishing.published] == [("Buzzer", "std_msgs/Bool")]
 
 
 def test_a_broken_pipe_reaches_the_runner_as_protocol_error(tmp_path: Path) -> None:

@@ -4,6 +4,7 @@ wait_for_message, new topic names, and sentences for what is missing."""
 
 from __future__ import annotations
 
+import itertools
 from pathlib import Path
 
 import pytest
@@ -77,7 +78,7 @@ def test_a_loop_that_never_sleeps_lets_time_pass_and_keeps_the_newest_queue_size
     times = [y.wake_at_s for y in yields]
     assert times == sorted(times) and times[0] > 0
     # Every yield after the free polls comes one busy slice of polled time after the last.
-    steps = {round((b - a) * 1e9) for a, b in zip(times, times[1:], strict=False)}
+    steps = {round((b - a) * 1e9) for a, b in itertools.pairwise(times)}
     assert steps == {BUSY_SLICE_NS}
     # The publisher's queue keeps at most queue_size=5 messages between two yields.
     assert max(len(y.published) for y in yields) == 5
@@ -156,7 +157,7 @@ def test_shutdown_hooks_publish_and_a_failing_hook_is_logged(
         """,
         tmp_path,
     )
-    yields, exited = parent.run_lockstep()
+    _yields, exited = parent.run_lockstep()
     assert exited.outcome is Outcome.FINISHED, exited.error
     assert parent.finishing.reason == "done driving"
     assert [Twist.deserialize(e.data) for e in parent.finishing.published] == [Twist()]
