@@ -90,7 +90,7 @@ def test_course_script_runs_unchanged_in_lockstep(
         assert [(e.topic, Twist.deserialize(e.data)) for e in frame.published] == [
             ("Control", forward)
         ]
-    assert [Twist.deserialize(e.data) for e in exited.published] == [Twist()]
+    assert [Twist.deserialize(e.data) for e in parent.last_published(exited)] == [Twist()]
     assert "[INFO] [1.600000]: stopped at 20 cm" in capsys.readouterr().out
 
     files = {artifact.name: artifact.data for artifact in exited.artifacts}

@@ -9,7 +9,7 @@ import pytest
 
 from sandbox.bwrap import SandboxUnavailable
 from sandbox.launcher import DANGER, Launcher, NodeUsageError
-from sandbox.protocol import Api, Envelope, Exited, Outcome, Yield
+from sandbox.protocol import Api, Envelope, Exited, Finishing, Outcome, Yield
 from tests.sandbox.conftest import crowbot_info, run_script
 
 COURSE_SCRIPT = """
@@ -61,6 +61,9 @@ def test_course_script_runs_unchanged_in_the_sandbox(launcher):
             assert [e.type for e in reply.published] == ["geometry_msgs/Twist"]
             reply = node.wake(0.1 * k, [distance(cm)])
             wakes.append(getattr(reply, "wake_at_s", None))
+        assert isinstance(reply, Finishing), reply  # its figures are still to come
+        assert reply.reason == "reached the wall"
+        reply = node.poll_finished(timeout_s=20.0)
         assert isinstance(reply, Exited), reply
         assert reply.outcome is Outcome.FINISHED
         assert reply.reason == "signal_shutdown: reached the wall"
