@@ -24,6 +24,7 @@ def test_listings_have_a_line_each():
         "crowbot",
         "ir_scout",
         "turtlebot",
+        "turtlebot3",
     ]
     worlds = robodojo("worlds").stdout.splitlines()
     assert len(worlds) == 6 and worlds[0].startswith("crop_rows")

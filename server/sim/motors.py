@@ -11,6 +11,11 @@ change speed instantly):
   start the motor) is not followed in simulation either.
 - `VelocityMotors` models a base with its own speed controller (the Roomba's Drive Direct, the
   rover's and the miniQ's H-bridges): per-wheel speed limit, acceleration limit and lag.
+- `OpenCrMotors` follows the TurtleBot3's OpenCR firmware (ROBOTIS-GIT/OpenCR, noetic-devel,
+  libraries/turtlebot3: turtlebot3_core.ino and turtlebot3_motor_driver.cpp): every 1/30 s it
+  writes each Dynamixel a goal velocity in its integer units (0.229 rpm), truncated and clamped
+  to +-265 units (61 rpm); a command older than 0.5 s is replaced by zero (the firmware's
+  cmd_vel watchdog, CONTROL_MOTOR_TIMEOUT). The wheels then follow with `VelocityMotors`' lag.
 """
 
 from __future__ import annotations
@@ -128,3 +133,74 @@ class VelocityMotors:
         self.left_rad_s = self._advance(self.left_rad_s, self.target_left_rad_s, dt_s)
         self.right_rad_s = self._advance(self.right_rad_s, self.target_right_rad_s, dt_s)
         return self.left_rad_s, self.right_rad_s
+
+
+# TurtleBot3 Burger firmware constants (OpenCR noetic-devel, turtlebot3_motor_driver.h and
+# turtlebot3_core_config.h).
+TB3_UNITS_PER_RAD_S = (
+    41.69988758  # [units/(rad/s)] VELOCITY_CONSTANT_VALUE = 1/(0.229 rpm in rad/s)
+)
+TB3_BURGER_LIMIT_UNITS = 265  # [units] BURGER_DXL_LIMIT_MAX_VELOCITY: 61 rpm at 12 V
+TB3_CONTROL_PERIOD_S = 1.0 / 30.0  # [s] CONTROL_MOTOR_SPEED_FREQUENCY, 30 Hz
+TB3_COMMAND_TIMEOUT_S = 0.5  # [s] CONTROL_MOTOR_TIMEOUT: no cmd_vel for 500 ms stops the wheels
+
+
+def dynamixel_units(wheel_rad_s: float, limit_units: int = TB3_BURGER_LIMIT_UNITS) -> int:
+    """The goal velocity the firmware writes for one wheel: x units per rad/s, clamped to the
+    limit, then cast to an integer (truncation toward zero, as the C cast does)."""
+    units = max(-limit_units, min(limit_units, wheel_rad_s * TB3_UNITS_PER_RAD_S))
+    return int(units)
+
+
+@dataclass(slots=True)
+class OpenCrMotors:
+    """The TurtleBot3's OpenCR path from a (clamped) Twist to its two Dynamixels (module doc).
+
+    `command()` is the cmd_vel callback: it stores the goal and restarts the watchdog. `step()`
+    runs the firmware's 30 Hz control loop on simulated time and lags the wheels toward the
+    goal written last. `timeout_s=None` turns the watchdog off."""
+
+    wheel_radius_m: float
+    track_m: float
+    wheels: VelocityMotors
+    limit_units: int = TB3_BURGER_LIMIT_UNITS
+    control_period_s: float = TB3_CONTROL_PERIOD_S
+    timeout_s: float | None = TB3_COMMAND_TIMEOUT_S
+    goal_linear_m_s: float = 0.0
+    goal_angular_rad_s: float = 0.0
+    since_command_s: float = math.inf  # [s] nothing commanded yet: the wheels stay still
+    since_control_s: float = 0.0
+    left_units: int = 0
+    right_units: int = 0
+
+    def reset(self) -> None:
+        self.wheels.reset()
+        self.goal_linear_m_s = self.goal_angular_rad_s = 0.0
+        self.since_command_s = math.inf
+        self.since_control_s = 0.0
+        self.left_units = self.right_units = 0
+
+    def command(self, linear_m_s: float, angular_rad_s: float) -> None:
+        self.goal_linear_m_s, self.goal_angular_rad_s = linear_m_s, angular_rad_s
+        self.since_command_s = 0.0
+
+    def _control(self) -> None:
+        """One pass of the firmware's control loop: goal (or zero, if stale) to wheel units."""
+        linear, angular = self.goal_linear_m_s, self.goal_angular_rad_s
+        if self.timeout_s is not None and self.since_command_s > self.timeout_s:
+            linear = angular = 0.0
+        left, right = wheel_speeds(linear, angular, self.wheel_radius_m, self.track_m)
+        self.left_units = dynamixel_units(left, self.limit_units)
+        self.right_units = dynamixel_units(right, self.limit_units)
+        self.wheels.target_left_rad_s = self.left_units / TB3_UNITS_PER_RAD_S
+        self.wheels.target_right_rad_s = self.right_units / TB3_UNITS_PER_RAD_S
+
+    def step(self, dt_s: float) -> tuple[float, float]:
+        self.since_command_s += dt_s
+        self.since_control_s += dt_s
+        if self.since_control_s >= self.control_period_s - 1e-12:
+            # A coarse physics tick may span several control passes: the last one wins.
+            self.since_control_s = max(self.since_control_s - self.control_period_s, 0.0)
+            self.since_control_s %= self.control_period_s
+            self._control()
+        return self.wheels.step(dt_s)

@@ -8,10 +8,11 @@ from server.sim.robots.crop_rover import CropRover
 from server.sim.robots.crowbot import CrowBot
 from server.sim.robots.ir_scout import IrScout
 from server.sim.robots.turtlebot import TurtleBot
+from server.sim.robots.turtlebot3 import TurtleBot3
 from server.sim.world import load_world, world_ids
 
 _ROBOTS: dict[str, type[RobotModel]] = {
-    cls.id: cls for cls in (CrowBot, CropRover, IrScout, TurtleBot)
+    cls.id: cls for cls in (CrowBot, CropRover, IrScout, TurtleBot, TurtleBot3)
 }
 
 

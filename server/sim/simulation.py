@@ -290,7 +290,7 @@ class Simulation:
         linear, angular = body_velocities(left, right, wheel_radius, track)
         pose = state.pose
         x, y, yaw = integrate_arc(pose.x, pose.y, pose.yaw, linear, angular, dt)
-        x, y = self._resolve_contacts(pose.x, pose.y, x, y)
+        x, y = self._resolve_contacts(pose.x, pose.y, pose.yaw, x, y, yaw)
         state.distance_travelled_m += math.hypot(x - pose.x, y - pose.y)
         pose.x, pose.y, pose.yaw = x, y, yaw
         state.linear_m_s, state.angular_rad_s = linear, angular
@@ -310,21 +310,26 @@ class Simulation:
             self._track_bounds(x, y, dt)
 
     def _resolve_contacts(
-        self, old_x: float, old_y: float, x: float, y: float
+        self, old_x: float, old_y: float, old_yaw: float, x: float, y: float, yaw: float
     ) -> tuple[float, float]:
-        """Push the body out of anything it overlaps; count contacts as they begin.
+        """Push the body out of anything it overlaps; count contacts as they begin. Takes and
+        returns the pose (the point between the wheels); the body disc sits `body_offset_x_m`
+        ahead of it, so turning on the spot sweeps an off-centre body as on the real robot.
 
-        A distance query costs tens of microseconds, so it only runs when the robot has used
+        A distance query costs tens of microseconds, so it only runs when the body has used
         up its last known clearance (conservative advancement): exact, and free in open space."""
-        radius = self.robot.geometry.body_radius_m
-        self._clearance_m -= math.hypot(x - old_x, y - old_y)
+        geometry = self.robot.geometry
+        radius, offset = geometry.body_radius_m, geometry.body_offset_x_m
+        old_cx, old_cy = old_x + offset * math.cos(old_yaw), old_y + offset * math.sin(old_yaw)
+        cx, cy = x + offset * math.cos(yaw), y + offset * math.sin(yaw)
+        self._clearance_m -= math.hypot(cx - old_cx, cy - old_cy)
         if self._clearance_m > 0.0:
             if self.state.in_contact:
                 self._set_contact(False, (), x, y)
             return x, y
         angles: np.ndarray = np.zeros(0)
         for _ in range(_COLLISION_ITERATIONS):
-            push, touching = self.obstacles.penetrations(x, y, radius)
+            push, touching = self.obstacles.penetrations(cx, cy, radius)
             if len(push) == 0:
                 break
             if len(angles) == 0:
@@ -332,10 +337,11 @@ class Simulation:
             # Resolve the deepest overlap first; a corner's second wall is the next pass.
             # (Summing would push twice at a box corner, where two edges share the point.)
             deepest = int(np.argmax(np.hypot(push[:, 0], push[:, 1])))
-            x += float(push[deepest, 0])
-            y += float(push[deepest, 1])
+            cx += float(push[deepest, 0])
+            cy += float(push[deepest, 1])
+        x, y = cx - offset * math.cos(yaw), cy - offset * math.sin(yaw)
         # Margin of 0.5 mm so a robot resting against a wall keeps reporting the contact.
-        self._clearance_m = self.obstacles.clearance(x, y) - radius - 0.0005
+        self._clearance_m = self.obstacles.clearance(cx, cy) - radius - 0.0005
         robot_frame = tuple(wrap_angle(float(a) - self.state.pose.yaw) for a in angles)
         self._set_contact(len(angles) > 0, robot_frame, x, y)
         return x, y

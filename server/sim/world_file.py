@@ -24,7 +24,13 @@ from server.sim.world_shapes import (
 )
 from server.sim.world_shapes import Problem as _Problem
 
-KNOWN_ROBOT_IDS: tuple[str, ...] = ("crowbot", "crop_rover", "ir_scout", "turtlebot")
+KNOWN_ROBOT_IDS: tuple[str, ...] = (
+    "crowbot",
+    "crop_rover",
+    "ir_scout",
+    "turtlebot",
+    "turtlebot3",
+)
 CYLINDER_KINDS: tuple[str, ...] = ("plant", "post")
 
 

@@ -179,7 +179,9 @@ def robot_info(robot_id: str) -> NodeInfo:
     )
 
 
-@pytest.mark.parametrize("robot_id", ["crowbot", "crop_rover", "ir_scout", "turtlebot"])
+@pytest.mark.parametrize(
+    "robot_id", ["crowbot", "crop_rover", "ir_scout", "turtlebot", "turtlebot3"]
+)
 def test_each_robot_example_runs_against_synthetic_sensors(tmp_path: Path, robot_id: str) -> None:
     info = robot_info(robot_id)
     sensors = [t for t in info.robot_topics if t.direction == "publish"]

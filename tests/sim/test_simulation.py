@@ -104,6 +104,7 @@ def _stream(robot: str, world: str, seed: int, command: tuple[str, object]) -> l
         ("crop_rover", "crop_rows", ("u", Float32(data=10.0))),
         ("ir_scout", "obstacle_maze", ("motor_command", String(data="forward"))),
         ("turtlebot", "office", ("cmd_vel", twist(0.2, 0.1))),
+        ("turtlebot3", "office", ("cmd_vel", twist(0.2, 0.1))),
     ],
 )
 def test_same_seed_gives_identical_streams_and_another_seed_different_noise(robot, world, command):
@@ -166,7 +167,9 @@ def test_bounds_events_and_time_out_of_bounds():
 
 # ------------------------------------------------------------------------------- bad input
 def test_unknown_robot_and_world_list_the_valid_ids():
-    with pytest.raises(UnknownRobotError, match="crop_rover, crowbot, ir_scout, turtlebot"):
+    with pytest.raises(
+        UnknownRobotError, match="crop_rover, crowbot, ir_scout, turtlebot, turtlebot3"
+    ):
         Simulation("crowbotz", "wall_approach")
     with pytest.raises(WorldError, match="wall_approach"):
         Simulation("crowbot", "moon_base")
@@ -231,7 +234,7 @@ def test_bad_step_seed_and_spawn_arguments():
 
 def test_registry_entries_are_valid():
     assert validate_registry() == []
-    assert robot_ids() == ("crop_rover", "crowbot", "ir_scout", "turtlebot")
+    assert robot_ids() == ("crop_rover", "crowbot", "ir_scout", "turtlebot", "turtlebot3")
 
 
 def test_scene_carries_what_the_view_draws():

@@ -24,7 +24,7 @@ from server.sim.world import (
 )
 
 WORLD_IDS = ("crop_rows", "light_arena", "line_track", "obstacle_maze", "office", "wall_approach")
-LARGE_ROBOTS = {"turtlebot", "crop_rover"}  # ~0.2 m radius; the others are ~0.06 m
+LARGE_ROBOTS = {"turtlebot", "crop_rover", "turtlebot3"}  # 0.11-0.2 m radius; others ~0.06 m
 
 
 def _file_data(world_id: str) -> dict:

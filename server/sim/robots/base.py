@@ -41,8 +41,9 @@ class TopicSpec:
 @dataclass(frozen=True, slots=True)
 class RobotGeometry:
     """Sizes [m]. The body is a disc of `body_radius_m` for collisions (the circumscribed circle
-    for a rectangular chassis, so the simulated robot never fits where the real one cannot);
-    `length_m`/`width_m`/`height_m` are for drawing."""
+    for a rectangular chassis, so the simulated robot never fits where the real one cannot),
+    centred `body_offset_x_m` ahead of the point between the wheels (negative: behind it, as on
+    a TurtleBot3 whose axle is near the front); `length_m`/`width_m`/`height_m` are for drawing."""
 
     body_radius_m: float
     wheel_radius_m: float
@@ -50,6 +51,7 @@ class RobotGeometry:
     length_m: float
     width_m: float
     height_m: float
+    body_offset_x_m: float = 0.0
 
 
 @dataclass(frozen=True, slots=True)
@@ -151,6 +153,11 @@ def validate_robot(robot: RobotModel) -> list[str]:
             problems.append(
                 f"robot '{robot.id}': geometry.{name} must be a positive size, got {value}"
             )
+    if not (math.isfinite(g.body_offset_x_m) and abs(g.body_offset_x_m) < g.body_radius_m):
+        problems.append(
+            f"robot '{robot.id}': geometry.body_offset_x_m must put the wheel axle inside the "
+            f"body (|offset| < body_radius_m), got {g.body_offset_x_m}"
+        )
     sensors = robot.build_sensors()
     if not sensors:
         problems.append(f"robot '{robot.id}': publishes no sensor topics")

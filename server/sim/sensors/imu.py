@@ -14,6 +14,10 @@ assumptions of the right order for the BNO055's fused heading, not datasheet val
   the elapsed simulated time at each sample, so its statistics do not depend on the rate; it
   draws only from the sensor's own generator and `reset()` returns it to its initial value.
 - Rate: 20 Hz (the Arduino bridge's publish rate; assumption).
+- Options for other boards: `heading_from_start` reports yaw relative to the heading at the first
+  sample after reset (an IMU without a magnetometer in its fusion, like the TurtleBot3's, starts
+  at yaw 0 wherever it is switched on); `fixed_covariances` (orientation, angular velocity,
+  linear acceleration variances) replaces the computed diagonals with a firmware's constants.
 """
 
 from __future__ import annotations
@@ -111,8 +115,13 @@ class Imu:
         accel_noise_sd_m_s2: float = _ACCEL_NOISE_SD_M_S2,
         tilt_sd_rad: float = _TILT_SD_RAD,
         frame_id: str = "imu_link",
+        heading_from_start: bool = False,
+        fixed_covariances: tuple[float, float, float] | None = None,
     ) -> None:
         self.rate_hz = float(rate_hz)
+        self.heading_from_start = heading_from_start
+        self.fixed_covariances = fixed_covariances
+        self._start_yaw_rad: float | None = None
         self.gyro_noise_sd_rad_s = float(gyro_noise_sd_rad_s)
         self.accel_noise_sd_m_s2 = float(accel_noise_sd_m_s2)
         self.tilt_sd_rad = float(tilt_sd_rad)
@@ -130,10 +139,16 @@ class Imu:
         self._yaw.reset()
         self._last_speed_m_s = None
         self._last_time_s = 0.0
+        self._start_yaw_rad = None
 
     def sample(self, ctx: SenseContext, rng: np.random.Generator) -> ImuMessage:
         state = ctx.state
-        yaw_rad = self._yaw.measure(state.pose.yaw, ctx.time_s, rng)
+        true_yaw_rad = state.pose.yaw
+        if self.heading_from_start:
+            if self._start_yaw_rad is None:
+                self._start_yaw_rad = true_yaw_rad
+            true_yaw_rad -= self._start_yaw_rad
+        yaw_rad = self._yaw.measure(true_yaw_rad, ctx.time_s, rng)
         gyro_noise, *accel_noise = rng.standard_normal(4).tolist()
 
         elapsed_s = ctx.time_s - self._last_time_s
@@ -145,20 +160,23 @@ class Imu:
         self._last_time_s = ctx.time_s
         accel_sd = self.accel_noise_sd_m_s2
         tilt_var = self.tilt_sd_rad**2
+        orientation_var = (tilt_var, tilt_var, self._yaw.variance(ctx.time_s))
+        gyro_var = (self.gyro_noise_sd_rad_s**2,) * 3
+        accel_var = (accel_sd**2,) * 3
+        if self.fixed_covariances is not None:
+            orientation_var, gyro_var, accel_var = ((v, v, v) for v in self.fixed_covariances)
         return ImuMessage(
             header=stamped_header(ctx.time_s, self.frame_id),
             orientation=yaw_quaternion(yaw_rad),
-            orientation_covariance=diagonal_covariance(
-                (tilt_var, tilt_var, self._yaw.variance(ctx.time_s))
-            ),
+            orientation_covariance=diagonal_covariance(orientation_var),
             angular_velocity=Vector3(
                 x=0.0, y=0.0, z=state.angular_rad_s + self.gyro_noise_sd_rad_s * gyro_noise
             ),
-            angular_velocity_covariance=diagonal_covariance((self.gyro_noise_sd_rad_s**2,) * 3),
+            angular_velocity_covariance=diagonal_covariance(gyro_var),
             linear_acceleration=Vector3(
                 x=forward_m_s2 + accel_sd * accel_noise[0],
                 y=state.linear_m_s * state.angular_rad_s + accel_sd * accel_noise[1],
                 z=_GRAVITY_M_S2 + accel_sd * accel_noise[2],
             ),
-            linear_acceleration_covariance=diagonal_covariance((accel_sd**2,) * 3),
+            linear_acceleration_covariance=diagonal_covariance(accel_var),
         )

@@ -59,7 +59,13 @@ class WheelOdometry(StatelessSensor):
         track_m: float = _TRACK_M,
         frame_id: str = "odom",
         child_frame_id: str = "base_link",
+        pose_variances: tuple[float, ...] = _POSE_VARIANCES,
+        twist_variances: tuple[float, ...] = _TWIST_VARIANCES,
     ) -> None:
+        """`pose_variances`/`twist_variances`: the six diagonal entries (x, y, z, roll, pitch,
+        yaw) the driver fills in; all zeros where the real firmware leaves them unset."""
+        if len(pose_variances) != 6 or len(twist_variances) != 6:
+            raise ValueError("WheelOdometry needs six pose and six twist variances")
         if wheel_radius_m <= 0.0 or track_m <= 0.0:
             raise ValueError(
                 f"WheelOdometry needs wheel_radius_m > 0 and track_m > 0, "
@@ -70,6 +76,8 @@ class WheelOdometry(StatelessSensor):
         self.track_m = float(track_m)
         self.frame_id = frame_id
         self.child_frame_id = child_frame_id
+        self.pose_covariance = diagonal_covariance(pose_variances)
+        self.twist_covariance = diagonal_covariance(twist_variances)
 
     def sample(self, ctx: SenseContext, rng: np.random.Generator) -> Odometry:
         state = ctx.state
@@ -83,12 +91,12 @@ class WheelOdometry(StatelessSensor):
             position=Point(x=odom_pose.x, y=odom_pose.y, z=0.0),
             orientation=yaw_quaternion(odom_pose.yaw),
         )
-        odometry.pose.covariance = diagonal_covariance(_POSE_VARIANCES)
+        odometry.pose.covariance = list(self.pose_covariance)
         odometry.twist.twist = Twist(
             linear=Vector3(x=0.5 * (left_m_s + right_m_s), y=0.0, z=0.0),
             angular=Vector3(x=0.0, y=0.0, z=(right_m_s - left_m_s) / self.track_m),
         )
-        odometry.twist.covariance = diagonal_covariance(_TWIST_VARIANCES)
+        odometry.twist.covariance = list(self.twist_covariance)
         return odometry
 
 
