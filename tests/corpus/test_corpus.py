@@ -337,7 +337,7 @@ CASES = (
         check_wall_follower,
         nodes=(Node("tb3_wall_follower.py"),),
         initial_pose=(2.6, 2.95, 0.0),
-        needs=("the turtlebot3 robot", "time advancing in a loop that never sleeps (issue 12, 2)"),
+        needs=("time advancing in a loop that never sleeps (issue 12, 2)",),
     ),
     Case(
         "square_time_now",
@@ -419,7 +419,7 @@ CASES = (
         check_tf2_distance,
         nodes=(Node("tf2_distance.py"),),
         spawn="start",
-        needs=("the turtlebot3 robot", "tf2_ros"),
+        needs=("tf2_ros",),
     ),
     Case(
         "tf_listener_drive",
@@ -477,7 +477,6 @@ CASES = (
         check_tb3_obstacle_stop,
         nodes=(Node("tb3_obstacle_stop.py"),),
         initial_pose=(2.6, 2.75, math.pi / 2),
-        needs=("the turtlebot3 robot",),
     ),
     Case(
         "tb3_closest_obstacle",
@@ -487,7 +486,6 @@ CASES = (
         check_tb3_closest,
         nodes=(Node("tb3_closest_obstacle.py"),),
         initial_pose=(3.0, 2.9, 0.0),
-        needs=("the turtlebot3 robot",),
     ),
     Case(
         "debug_topic",
