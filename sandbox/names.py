@@ -138,8 +138,8 @@ def load_mappings(argv: Iterable[str]) -> dict[str, str]:
     `_param:=value` arguments are parameters, not remappings, and are left out."""
     mappings: dict[str, str] = {}
     for arg in argv:
-        if not is_remap_arg(arg):
-            continue
+        if not is_remap_arg(arg) or arg.count(REMAP) != 1:
+            continue  # rosgraph skips `a:=b:=c` (with an error line)
         source, _, target = (part.strip() for part in arg.partition(REMAP))
         if source and target and not (len(source) > 1 and source[0] == "_" and source[1] != "_"):
             mappings[source] = target
@@ -163,6 +163,8 @@ def load_private_params(argv: Iterable[str]) -> dict[str, Any]:
     for arg in argv:
         if not is_remap_arg(arg):
             continue
+        if arg.count(REMAP) != 1:
+            raise InvalidName(f"invalid command-line parameter '{arg}': one ':=' per argument")
         source, _, target = (part.strip() for part in arg.partition(REMAP))
         if source and target and len(source) > 1 and source[0] == "_" and source[1] != "_":
             params[source[1:]] = parse_param_value(target)

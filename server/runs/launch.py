@@ -37,6 +37,7 @@ from server.runs.launch_xml import (
     Element,
     SubstitutionError,
     Substitutions,
+    XmlError,
     parse_xml,
 )
 from server.runs.spec import NodeSpec, RunSpecError
@@ -215,8 +216,8 @@ class _Reader:
             raise LaunchFileError(path, None, f"larger than {MAX_LAUNCH_BYTES // 1024} KiB")
         try:
             root = parse_xml(text)
-        except SyntaxError as error:
-            raise LaunchFileError(path, error.lineno, str(error.msg)) from None
+        except XmlError as error:
+            raise LaunchFileError(path, error.line, str(error)) from None
         if root.tag != "launch":
             raise LaunchFileError(
                 path, root.line, f"the root element must be <launch>, not <{root.tag}>"

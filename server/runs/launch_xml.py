@@ -21,6 +21,14 @@ _SUBSTITUTION = re.compile(r"\$\(([^()]*)\)")
 _COMMANDS = ("find", "env", "optenv", "dirname", "anon", "arg", "eval")
 
 
+class XmlError(ValueError):
+    """The text is not well-formed XML (or declares entities); `line` is where [1-based]."""
+
+    def __init__(self, message: str, line: int) -> None:
+        super().__init__(message)
+        self.line = line
+
+
 class SubstitutionError(ValueError):
     """A substitution arg cannot be resolved; the message says which and why."""
 
@@ -41,7 +49,7 @@ class Element:
 
 
 def parse_xml(text: str) -> Element:
-    """The root element of `text`; SyntaxError(message, line) if it is not well-formed XML.
+    """The root element of `text`; XmlError if it is not well-formed XML.
     Expat does not fetch external entities; DOCTYPE internal entities are refused outright
     (entity expansion is the one way a small XML file becomes a large one)."""
     parser = xml.parsers.expat.ParserCreate()
@@ -61,7 +69,7 @@ def parse_xml(text: str) -> Element:
             stack[-1].text += chunk
 
     def entity(*_args: object) -> None:
-        raise SyntaxError("entity declarations are not allowed in a launch file")
+        raise XmlError("entity declarations are not allowed in a launch file", 0)
 
     parser.StartElementHandler = start
     parser.EndElementHandler = end
@@ -71,9 +79,9 @@ def parse_xml(text: str) -> Element:
         parser.Parse(text, True)
     except xml.parsers.expat.ExpatError as error:
         message = xml.parsers.expat.ErrorString(error.code)
-        raise SyntaxError(f"this is not well-formed XML ({message})", error.lineno) from None
-    except SyntaxError as error:
-        raise SyntaxError(str(error.msg), parser.CurrentLineNumber) from None
+        raise XmlError(f"this is not well-formed XML ({message})", error.lineno) from None
+    except XmlError as error:
+        raise XmlError(str(error), parser.CurrentLineNumber) from None
     return roots[0]
 
 

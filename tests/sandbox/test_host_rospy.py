@@ -268,7 +268,7 @@ def test_params_logging_and_publish_forms(
         assert rospy.get_name().startswith("/p_")
         """,
         tmp_path,
-        info=crowbot_info(params={"gain": 2.5}),
+        info=crowbot_info(params={"~gain": 2.5}),  # private: a <param> inside <node>
     )
     assert exited.outcome is Outcome.FINISHED, exited.error
     out = capsys.readouterr().out
@@ -276,6 +276,40 @@ def test_params_logging_and_publish_forms(
     assert "not shown" not in out
     assert out.count("once only") == 1
     assert [e.topic for e in exited.published] == ["Leds", "Buzzer"]
+
+
+def test_launch_style_names_and_parameters_inside_the_sandbox(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # What a launch file gives a node: __name:= and _param:= on its command line, a namespace,
+    # run-wide (global) and private parameters. PyYAML types the _param:= values in the sandbox.
+    _, exited = run(
+        """
+        import rospy
+        rospy.init_node("ignored_by_launch", anonymous=True)
+        print("name", rospy.get_name(), rospy.get_namespace())
+        print("speed", repr(rospy.get_param("~speed")), repr(rospy.get_param("~mode")))
+        print("global", rospy.get_param("/waypoints"), rospy.search_param("waypoints"))
+        print("tree", sorted(rospy.get_param("~").items()))
+        try:
+            rospy.get_param("~nothing")
+        except KeyError as error:
+            print("missing", error)
+        """,
+        tmp_path,
+        info=crowbot_info(
+            params={"waypoints": [[1, 2]], "~speed": 0.25},
+            argv=["_mode:=wall", "_speed:=0.5", "__name:=follower"],
+            namespace="/robot1",
+        ),
+    )
+    assert exited.outcome is Outcome.FINISHED, exited.error
+    out = capsys.readouterr().out
+    assert "name /robot1/follower /robot1/" in out
+    assert "speed 0.5 'wall'" in out  # the command line wins over the launch's ~speed
+    assert "global [[1, 2]] /waypoints" in out
+    assert "tree [('mode', 'wall'), ('speed', 0.5)]" in out
+    assert "missing parameter /robot1/follower/nothing (asked as '~nothing') is not set" in out
 
 
 def test_python_logging_prints_rospy_style_lines(

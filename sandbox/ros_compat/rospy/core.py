@@ -1,14 +1,20 @@
-"""Node life cycle, parameters and spin (rospy.client / rospy.core look-alikes)."""
+"""Node life cycle, names, parameters and spin (rospy.client / rospy.core look-alikes).
+
+Names resolve as in rospy (sandbox.names: namespaces, `~private`, remapping, `__name:=`);
+parameters live in the node's own copy of the parameter server (sandbox.params), filled from
+the run's parameters (global) and the node's private ones (`~x`, `_x:=value`) at init_node."""
 
 from __future__ import annotations
 
 import sys
-import zlib
 from collections.abc import Callable
 from typing import Any
 
 from sandbox import runtime as _runtime
-from sandbox.runtime import ROSException, ROSInterruptException, normalize_param
+from sandbox.names import InvalidName, Names, check_name, namespace_of, resolve
+from sandbox.names import myargv as myargv_of
+from sandbox.params import ParamNotSet, ParamServer, initial_params
+from sandbox.runtime import ROSException, ROSInitException, ROSInterruptException
 
 # Log levels, with rospy's values.
 DEBUG = 1
@@ -18,6 +24,33 @@ ERROR = 8
 FATAL = 16
 
 _UNSET = object()
+
+
+def _names(node: Any = None) -> Names:
+    """The node's names (sandbox.names.Names), made from its NodeInfo on first use."""
+    node = node or _runtime.current()
+    names = getattr(node, "names", None)
+    if names is None:
+        try:
+            names = Names.from_info(node.info)
+        except InvalidName as error:
+            raise ROSInitException(f"this node's command line or launch file: {error}") from None
+        node.names = names
+    return names
+
+
+def _params(node: Any = None) -> ParamServer:
+    """The node's copy of the parameter server, filled from the run's parameters."""
+    node = node or _runtime.current()
+    server = getattr(node, "param_server", None)
+    if server is None:
+        global_params, _ = initial_params(node.info.params)
+        try:
+            server = ParamServer(global_params)
+        except (TypeError, OverflowError) as error:
+            raise ROSInitException(f"the run's parameters: {error}") from None
+        node.param_server = server
+    return server
 
 
 def init_node(
@@ -31,28 +64,40 @@ def init_node(
     xmlrpc_port: int = 0,
     tcpros_port: int = 0,
 ) -> None:
-    """Name this node; required once before publishers, subscribers, rates and sleeps."""
+    """Name this node (`__name:=` on its command line wins, as in rospy); required once before
+    rates and sleeps. Its private parameters (`_x:=value`, a launch file's ~params) are set."""
     node = _runtime.current()
-    if not isinstance(name, str) or not name.strip("/") or "/" in name.strip("/"):
-        raise ValueError(f"init_node() takes a plain node name such as 'follower', got {name!r}")
-    full = "/" + name.strip("/")
-    if anonymous:
-        # Deterministic, unlike rospy's pid/time suffix, so lockstep runs repeat exactly.
-        full += f"_{zlib.crc32(node.info.node_name.encode()):08x}"
-    if node.node_name is not None and node.node_name != full and not node.implicit_name:
+    names = _names(node)
+    call = (name, None if argv is None else list(argv), anonymous, log_level)
+    if node.node_name is not None and not node.implicit_name:
+        if getattr(node, "init_call", None) == call:
+            return  # rospy allows a repeated call with the same arguments
         raise ROSException(
             f"rospy.init_node() has already been called with name {node.node_name!r}; "
             "call it once per node"
         )
+    try:
+        full = names.init(name, anonymous, argv)
+    except InvalidName as error:
+        raise ValueError(str(error)) from None
     node.node_name = full
     node.implicit_name = False
+    node.init_call = call
+    server = _params(node)
+    _, private = initial_params(node.info.params)
+    try:
+        for key, value in {**private, **names.private_params()}.items():
+            server.set(names.param(key), value)
+    except (InvalidName, TypeError, OverflowError) as error:
+        raise ROSInitException(f"invalid command-line parameters: {error}") from None
     if log_level is not None:
         node.log_level = log_level
 
 
 def get_name() -> str:
-    name = _runtime.current().node_name
-    return name if name is not None else "/unnamed"
+    """The node's full name (`/ns/name`); `<namespace>unnamed` before init_node, as rospy."""
+    node = _runtime.current()
+    return node.node_name or _names(node).caller_id
 
 
 def get_caller_id() -> str:
@@ -60,7 +105,22 @@ def get_caller_id() -> str:
 
 
 def get_namespace() -> str:
-    return "/"
+    """The node's namespace with a trailing slash: `/` or `/robot1/`."""
+    node = _runtime.current()
+    if node.node_name is not None:
+        return namespace_of(node.node_name)
+    return _names(node).namespace
+
+
+def resolve_name(name: str, caller_id: str | None = None) -> str:
+    """The global name `name` stands for in this node, remapping applied (rospy.resolve_name)."""
+    names = _names()
+    try:
+        if caller_id:
+            return resolve(check_name(name), caller_id, names.resolved_mappings)
+        return names.resolve(name)
+    except InvalidName as error:
+        raise ValueError(str(error)) from None
 
 
 def get_node_uri() -> str:
@@ -68,8 +128,8 @@ def get_node_uri() -> str:
 
 
 def myargv(argv: list[str] | None = None) -> list[str]:
-    """argv without ROS remapping arguments (`name:=value`)."""
-    return [arg for arg in (sys.argv if argv is None else argv) if ":=" not in arg]
+    """argv without ROS's `name:=value` arguments (remappings, `_param:=`, `__name:=`)."""
+    return myargv_of(sys.argv if argv is None else argv)
 
 
 def is_shutdown() -> bool:
@@ -105,26 +165,21 @@ def spin() -> None:
 
 
 # ---------------------------------------------------------------------- parameters
-def _param_key(name: str) -> str:
-    if not isinstance(name, str) or not name.strip("/~"):
-        raise KeyError(f"a parameter name is a non-empty string, got {name!r}")
-    key = normalize_param(name)
-    node_name = (_runtime.current().node_name or "").strip("/")
-    if node_name and key.startswith(node_name + "/"):
-        key = key[len(node_name) + 1 :]
-    return key
+def _param_name(name: Any) -> str:
+    """The absolute name of a parameter for this node (private, relative, global, remapped)."""
+    return _names().param(name)
 
 
 def get_param(param_name: str, default: Any = _UNSET) -> Any:
-    """A run parameter; `~name` (private) and `name` read the same value here."""
-    params = _runtime.current().params
-    key = _param_key(param_name)
-    if key in params:
-        return params[key]
-    if default is _UNSET:
-        known = ", ".join(sorted(params)) or "none"
-        raise KeyError(f"parameter {param_name!r} is not set (parameters of this run: {known})")
-    return default
+    """A parameter's value (a dict for a namespace); KeyError if unset and no default."""
+    server = _params()
+    resolved = _param_name(param_name)
+    try:
+        return server.get(resolved)
+    except ParamNotSet:
+        if default is not _UNSET:
+            return default
+        raise ParamNotSet(server.missing_sentence(resolved, param_name)) from None
 
 
 def get_param_cached(param_name: str, default: Any = _UNSET) -> Any:
@@ -132,24 +187,34 @@ def get_param_cached(param_name: str, default: Any = _UNSET) -> Any:
 
 
 def set_param(param_name: str, param_value: Any) -> None:
-    _runtime.current().params[_param_key(param_name)] = param_value
+    """Set a parameter; a dict sets (and replaces) the namespace under `param_name`."""
+    _params().set(_param_name(param_name), param_value)
 
 
 def has_param(param_name: str) -> bool:
-    return _param_key(param_name) in _runtime.current().params
+    return _params().has(_param_name(param_name))
 
 
 def delete_param(param_name: str) -> None:
-    params = _runtime.current().params
-    key = _param_key(param_name)
-    if key not in params:
-        raise KeyError(param_name)
-    del params[key]
+    """Delete a parameter or a namespace; KeyError if it is not set."""
+    server = _params()
+    resolved = _param_name(param_name)
+    try:
+        server.delete(resolved)
+    except ParamNotSet:
+        raise ParamNotSet(server.missing_sentence(resolved, param_name)) from None
 
 
 def search_param(param_name: str) -> str | None:
-    return "/" + _param_key(param_name) if has_param(param_name) else None
+    """The full name of the closest parameter called `param_name`, looking in this node's
+    private namespace, then each enclosing namespace up to the root (rospy.search_param)."""
+    names = _names()
+    if not isinstance(param_name, str) or not param_name or param_name.startswith("~"):
+        raise ValueError(f"search_param() takes a relative or global name, got {param_name!r}")
+    key = names.mappings.get(param_name, param_name)  # rospy searches with unresolved mappings
+    return _params().search(names.search_start(), key)
 
 
 def get_param_names() -> list[str]:
-    return ["/" + key for key in sorted(_runtime.current().params)]
+    """Every parameter's full name."""
+    return _params().names()
