@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from sandbox.msgs import Message, get_message_class
+from sandbox.names import Names
 from sandbox.protocol import (
     Clock,
     Envelope,
@@ -42,7 +43,7 @@ from sandbox.protocol import (
     Wake,
     Yield,
 )
-from sandbox.services import NodeServices
+from sandbox.services import NodeServices, is_internal
 from sandbox.timers import TimerSchedule
 from sandbox.vclock import NodeClock
 
@@ -147,6 +148,7 @@ class NodeRuntime:
     timers: TimerSchedule = field(default_factory=TimerSchedule)
     services: NodeServices = field(default_factory=NodeServices)
     wake_topics: set[str] = field(default_factory=set)  # always wake early (service requests)
+    names: Names | None = None  # ROS name resolution for this node (sandbox.names)
     _polls: int = 0
     _woken_ns: int = 0
     _woken_wall_s: float = 0.0
@@ -158,6 +160,20 @@ class NodeRuntime:
         self.params = {normalize_param(key): value for key, value in self.info.params.items()}
         self._woken_ns = self.clock.now_ns()
         self._woken_wall_s = time.monotonic()
+        if self.names is None:
+            self.names = Names.from_info(self.info)
+
+    def bus_name(self, topic: Any) -> str:
+        """The run's name for a topic this node names: resolved against the node's namespace
+        and name and remapped, as rospy does (sandbox.names); internal service topics as they
+        are."""
+        if isinstance(topic, str) and is_internal(topic):
+            return topic
+        if not isinstance(topic, str) or not topic.strip("/"):
+            raise ROSException(
+                f"a topic name is a non-empty string such as 'Distance', got {topic!r}"
+            )
+        return self.names.topic(topic)
 
     # ------------------------------------------------------------------ state and contracts
     @property
@@ -239,7 +255,7 @@ class NodeRuntime:
         checked = self._advertise_checked.get((topic, data_class))
         if checked is not None:
             return checked
-        name = normalize_topic(topic)
+        name = self.bus_name(topic)
         robot = self._robot.get(name)
         if robot is not None and robot[1] == "publish":
             raise ROSException(
@@ -265,7 +281,7 @@ class NodeRuntime:
         args: Any = None,
         queue_size: int | None = None,
     ) -> Subscription:
-        name = normalize_topic(topic)
+        name = self.bus_name(topic)
         type_name = self._check_type(name, data_class)
         if name not in self._types:
             self._new_topic(name)
@@ -520,12 +536,6 @@ def _student_traceback(error: BaseException, filename: str) -> str:
 def format_log_line(level_name: str, time_s: float, text: str) -> str:
     """rospy's screen format: `[INFO] [12.300000]: text`."""
     return f"[{level_name}] [{time_s:.6f}]: {text}"
-
-
-def normalize_topic(topic: Any) -> str:
-    if not isinstance(topic, str) or not topic.strip("/"):
-        raise ROSException(f"a topic name is a non-empty string such as 'Distance', got {topic!r}")
-    return topic.lstrip("/")
 
 
 def normalize_param(name: str) -> str:

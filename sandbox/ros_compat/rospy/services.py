@@ -12,14 +12,15 @@ from typing import Any
 
 from sandbox import runtime as _runtime
 from sandbox.msgs import Duration, Message
-from sandbox.runtime import ROSException, ROSSerializationException, normalize_topic
+from sandbox.runtime import ROSException, ROSSerializationException
 from sandbox.services import AVAILABILITY_POLL_NS, ServiceException
 
 
 def _service_name(name: Any) -> str:
+    """The service's name in the run, resolved and remapped as rospy does (no leading '/')."""
     if not isinstance(name, str) or not name.strip("/"):
         raise ValueError(f"a service name is a non-empty string such as 'reset', got {name!r}")
-    return normalize_topic(name)
+    return _runtime.current().names.service(name)
 
 
 def _check_class(service_class: Any, what: str) -> None:
