@@ -162,7 +162,8 @@ def test_broadcasters_publish_tf_and_latched_tf_static(tmp_path: Path) -> None:
     )
     yields, exited = parent.run_lockstep()
     assert exited.outcome is Outcome.FINISHED, exited
-    published = [e for frame in [*yields, exited] for e in frame.published]
+    published = [e for frame in yields for e in frame.published]
+    published += parent.last_published(exited)  # sent as the script ended
     assert [(e.topic, e.type) for e in published] == [
         ("tf_static", "tf2_msgs/TFMessage"),
         ("tf", "tf2_msgs/TFMessage"),
