@@ -150,7 +150,8 @@ class Simulation:
             self.seed = seed
         spawn = self._spawn_pose(self._spawn)
         self.state = RobotState(pose=spawn, odometry_pose=Pose2D(0.0, 0.0, 0.0))
-        self._odom_origin = spawn
+        # A copy: `spawn` becomes the state's pose, which the physics moves in place.
+        self._odom_origin = Pose2D(spawn.x, spawn.y, spawn.yaw)
         self.lights = self.world.lights
         self.motors = self.robot.build_motors()
         self.motors.reset()

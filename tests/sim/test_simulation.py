@@ -256,3 +256,15 @@ def test_scene_rays_end_where_the_sensor_measured():
     ir = Simulation("ir_scout", "wall_approach", seed=0)
     ir.step(0.1)
     assert ir.scene().rays["ir_range"].shape == (1, 4)
+
+
+def test_the_odometry_origin_stays_where_the_robot_started():
+    # map -> odom on /tf is drawn from it: were it to move with the robot, every tf lookup of
+    # odom -> base_link would read zero.
+    sim = Simulation("turtlebot", "office", seed=0, spawn="corridor")
+    start = sim.odometry_origin
+    for _ in range(20):
+        sim.apply("cmd_vel", twist(0.2))
+        sim.step(0.1)
+    assert sim.state.pose.x > start.x + 0.2
+    assert (sim.odometry_origin.x, sim.odometry_origin.y) == pytest.approx((0.7, 3.1))
