@@ -3,6 +3,9 @@
     robodojo robots                       # the robots, a line each (--topics for their topics)
     robodojo worlds                       # the worlds, a line each
     robodojo run --robot crowbot --world wall_approach --node examples/step_api/crowbot.py
+    robodojo run --robot turtlebot3 --world maze --node follower=wall.py --param speed=0.2 \
+                 --remap scan:=base_scan --args "_gain:=1.5"   # rosrun-style, per node
+    robodojo run --robot turtlebot3 --world maze --launch pkg/launch/two.launch speed:=0.3
     robodojo export RUN_DIR               # a CSV per topic from a run's recording
     robodojo serve                        # the web lab (server/api/serve.py)
 
@@ -25,6 +28,15 @@ from pathlib import Path
 from sandbox.bwrap import SandboxUnavailable
 from sandbox.launcher import Launcher
 from sandbox.protocol import Clock
+from server.cli_nodes import (
+    data_files,
+    launch_arguments,
+    node_file_spec,
+    nodes_from_flags,
+    read_workspace,
+    workspace_folder,
+)
+from server.runs.launch import load_launch
 from server.runs.run import Run
 from server.runs.spec import NodeSpec, RunSpec, RunSpecError
 from server.runs.state import RunState
@@ -56,11 +68,51 @@ def _cmd_worlds(_: argparse.Namespace) -> int:
 
 def _node_specs(values: list[str]) -> tuple[NodeSpec, ...]:
     """`--node FILE` or `--node NAME=FILE`, as in a launch file."""
-    nodes = []
-    for value in values:
-        name, _, path = value.rpartition("=") if "=" in value else ("", "", value)
-        nodes.append(NodeSpec.from_file(path, name or None))
-    return tuple(nodes)
+    return tuple(node_file_spec(value) for value in values)
+
+
+class _InOrder(argparse.Action):
+    """Keeps --node/--param/--remap/--args/--ns in command-line order: a flag after a --node
+    belongs to that node."""
+
+    def __call__(self, parser, namespace, values, option_string=None) -> None:
+        ordered = list(getattr(namespace, "ordered", None) or [])
+        ordered.append((self.dest, values))
+        namespace.ordered = ordered
+
+
+def _nodes_and_files(args: argparse.Namespace) -> tuple[tuple[NodeSpec, ...], dict, tuple]:
+    """The run's nodes, run-wide params and workspace data files, from --node flags or a
+    --launch file."""
+    ordered = args.ordered or []
+    if args.launch is None:
+        if args.workspace:
+            raise ValueError("--workspace goes with --launch FILE")
+        nodes, params = nodes_from_flags(ordered)
+        if not nodes:
+            raise ValueError("give the code to run: --node [NAME=]FILE (repeat) or --launch FILE")
+        return nodes, params, ()
+    if any(flag in ("node", "remap", "args", "ns") for flag, _ in ordered):
+        raise ValueError(
+            "--launch runs the nodes its file names; put remaps and arguments in the launch "
+            "file (or use --node instead of --launch)"
+        )
+    launch_file, launch_args = Path(args.launch[0]), args.launch[1:]
+    if not launch_file.is_file():
+        raise ValueError(f"launch file '{launch_file}' does not exist (or is not a file)")
+    folder = Path(args.workspace) if args.workspace else workspace_folder(launch_file)
+    try:
+        relative = launch_file.resolve().relative_to(folder.resolve()).as_posix()
+    except ValueError:
+        raise ValueError(
+            f"launch file '{launch_file}' is not inside the workspace '{folder}'"
+        ) from None
+    workspace = read_workspace(folder)
+    plan = load_launch(relative, workspace, launch_arguments(launch_args))
+    _, run_params = nodes_from_flags(ordered)  # --param NAME=VALUE: run-wide, as before
+    for note in plan.notes:
+        print(f"robodojo: note: {note}", file=sys.stderr)
+    return plan.nodes, {**plan.params, **run_params}, data_files(workspace)
 
 
 class Progress:
@@ -99,14 +151,17 @@ class Progress:
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
+    nodes, params, files = _nodes_and_files(args)
     spec = RunSpec(
         robot=args.robot,
         world=args.world,
-        nodes=_node_specs(args.node),
+        nodes=nodes,
         clock=Clock(args.clock),
         duration_s=args.duration,
         seed=args.seed,
         spawn=args.spawn,
+        params=params,
+        files=files,
     )
     spec.validate()
     out_dir = (
@@ -213,10 +268,37 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--world", required=True, help=f"one of {', '.join(world_ids())}")
     run.add_argument(
         "--node",
-        action="append",
-        required=True,
+        action=_InOrder,
         metavar="[NAME=]FILE",
         help="a controller file; repeat for several nodes",
+    )
+    run.add_argument(
+        "--param",
+        action=_InOrder,
+        metavar="NAME=VALUE",
+        help="a parameter (YAML-typed): after a --node that node's own (~NAME), before any "
+        "--node run-wide",
+    )
+    run.add_argument("--remap", action=_InOrder, metavar="FROM:=TO", help="rename a topic")
+    run.add_argument(
+        "--args",
+        action=_InOrder,
+        metavar='"ARGS"',
+        help="the node's command line, as rosrun's (--args=\"--flag\" for one starting with -)",
+    )
+    run.add_argument("--ns", action=_InOrder, metavar="NAMESPACE", help="the node's namespace")
+    run.add_argument(
+        "--launch",
+        nargs="+",
+        default=None,
+        metavar=("FILE", "NAME:=VALUE"),
+        help="a ROS 1 .launch file, then its arguments as roslaunch takes them",
+    )
+    run.add_argument(
+        "--workspace",
+        default=None,
+        metavar="DIR",
+        help="the folder the launch file's nodes and data come from (default: its package)",
     )
     run.add_argument("--duration", type=_positive_seconds, default=30.0, help="seconds")
     run.add_argument("--clock", choices=[c.value for c in Clock], default=Clock.LOCKSTEP.value)
@@ -228,7 +310,7 @@ def build_parser() -> argparse.ArgumentParser:
         action="store_true",
         help="DANGER: run student code without bubblewrap (trusted code on a laptop only)",
     )
-    run.set_defaults(func=_cmd_run)
+    run.set_defaults(func=_cmd_run, ordered=None)
 
     commands.add_parser("exercises", help="list the exercises").set_defaults(func=_cmd_exercises)
     check = commands.add_parser("check", help="run an exercise headless and grade it")
