@@ -101,9 +101,6 @@ def test_a_launch_file_runs_two_nodes_with_a_private_param_and_a_data_file(tmp_p
     assert 10 <= len(said) <= 16  # 5 Hz from the launch file's rate_hz for 3 s
 
 
-@pytest.mark.xfail(
-    strict=True, reason="topic remapping needs sandbox/runtime.py to resolve names (lead)"
-)
 def test_a_launch_file_remap_carries_the_talk_to_the_listener(tmp_path) -> None:
     launch = write_package(tmp_path / "chat", remap=True)
     out = tmp_path / "run"
