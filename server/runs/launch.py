@@ -38,6 +38,7 @@ from server.runs.launch_xml import (
     SubstitutionError,
     Substitutions,
     XmlError,
+    load_yaml,
     parse_xml,
 )
 from server.runs.spec import NodeSpec, RunSpecError
@@ -412,7 +413,7 @@ def convert_value(value: str, kind: str) -> Any:
             return lowered in ("true", "1")
         raise ValueError(f"'{value}' is not a bool (true, false, 1 or 0)")
     try:
-        return yaml.safe_load(value)
+        return load_yaml(value)
     except yaml.YAMLError as error:
         raise ValueError(f"the value is not valid YAML: {error}") from None
 

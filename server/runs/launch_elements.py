@@ -20,7 +20,7 @@ from server.runs.launch import (
     _Scope,
     convert_value,
 )
-from server.runs.launch_xml import Element
+from server.runs.launch_xml import Element, load_yaml
 from server.runs.spec import NodeSpec
 
 Handler = Callable[[_Reader, Element, _Scope, int], None]
@@ -136,7 +136,7 @@ def _rosparam(reader: _Reader, element: Element, scope: _Scope, depth: int, node
     if reader.boolean(subst, "subst_value", element, scope):
         text = _substitute_text(reader, element, scope, text)
     try:
-        data = yaml.safe_load(text)
+        data = load_yaml(text)
     except yaml.YAMLError as error:
         source = f"file '{file}'" if file else "inline YAML"
         raise reader.error(

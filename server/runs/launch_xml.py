@@ -5,16 +5,27 @@ Substitution args follow roslaunch's substitution_args.py and the roslaunch XML 
 (http://wiki.ros.org/roslaunch/XML, "substitution args"): `$(arg)`, `$(env)`, `$(optenv)`,
 `$(anon)` and `$(dirname)` resolve first, `$(find)` after, left to right. `$(eval ...)` is
 Python's eval in roslaunch; a web server does not run it, so it is refused with a sentence.
+
+YAML is read as rosparam reads it (tools/rosparam/src/rosparam/__init__.py): yaml.safe_load
+plus the angle tags, `deg(90)` / `!degrees 90` (to radians) and `rad(pi/2)` / `!radians pi/2`.
+rosparam evaluates a radian expression with Python's eval; here it is arithmetic on numbers and
+`pi` only (+ - * / and parentheses), which covers what rosparam documents.
 `$(env VAR)` reads the server's environment in roslaunch: refused too (a run has no shell
 environment); `$(optenv VAR default)` gives its default.
 """
 
 from __future__ import annotations
 
+import ast
+import math
+import operator
 import re
 import xml.parsers.expat
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
+
+import yaml
 
 MAX_LAUNCH_BYTES = 256 * 1024  # [bytes] a launch file larger than this is not hand-written
 _SUBSTITUTION = re.compile(r"\$\(([^()]*)\)")
@@ -162,3 +173,62 @@ class Substitutions:
         if len(params) != 1:
             raise SubstitutionError(f"{whole} takes exactly one package name")
         return self.find(params[0])
+
+
+class RosparamLoader(yaml.SafeLoader):
+    """yaml.SafeLoader with rosparam's angle tags."""
+
+
+_OPERATORS = {
+    ast.Add: operator.add,
+    ast.Sub: operator.sub,
+    ast.Mult: operator.mul,
+    ast.Div: operator.truediv,
+    ast.USub: operator.neg,
+    ast.UAdd: operator.pos,
+}
+
+
+def _arithmetic(node: ast.AST) -> float:
+    if isinstance(node, ast.Expression):
+        return _arithmetic(node.body)
+    if isinstance(node, ast.Constant) and isinstance(node.value, (int, float)):
+        return float(node.value)
+    if isinstance(node, ast.Name) and node.id == "pi":
+        return math.pi
+    if isinstance(node, ast.BinOp) and type(node.op) in _OPERATORS:
+        return _OPERATORS[type(node.op)](_arithmetic(node.left), _arithmetic(node.right))
+    if isinstance(node, ast.UnaryOp) and type(node.op) in _OPERATORS:
+        return _OPERATORS[type(node.op)](_arithmetic(node.operand))
+    raise ValueError("not arithmetic")
+
+
+def _angle(text: str, prefix: str) -> float:
+    text = text.strip()
+    if text.startswith(prefix + "(") and text.endswith(")"):
+        text = text[len(prefix) + 1 : -1]
+    try:
+        return _arithmetic(ast.parse(text, mode="eval"))
+    except (SyntaxError, ValueError, ZeroDivisionError):
+        raise yaml.YAMLError(
+            f"invalid angle '{text}': use a number or arithmetic with pi, e.g. rad(pi/2)"
+        ) from None
+
+
+def _radians(loader: yaml.SafeLoader, node: yaml.Node) -> float:
+    return _angle(str(loader.construct_scalar(node)), "rad")  # type: ignore[arg-type]
+
+
+def _degrees(loader: yaml.SafeLoader, node: yaml.Node) -> float:
+    return math.radians(_angle(str(loader.construct_scalar(node)), "deg"))  # type: ignore[arg-type]
+
+
+RosparamLoader.add_constructor("!radians", _radians)
+RosparamLoader.add_constructor("!degrees", _degrees)
+RosparamLoader.add_implicit_resolver("!degrees", re.compile(r"^deg\([^\)]*\)$"), ["d"])
+RosparamLoader.add_implicit_resolver("!radians", re.compile(r"^rad\([^\)]*\)$"), ["r"])
+
+
+def load_yaml(text: str) -> Any:
+    """YAML as rosparam reads it; yaml.YAMLError on bad input."""
+    return yaml.load(text, Loader=RosparamLoader)  # a SafeLoader subclass: no Python objects

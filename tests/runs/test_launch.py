@@ -384,3 +384,26 @@ def test_entity_declarations_are_refused() -> None:
     with pytest.raises(LaunchFileError, match="entity declarations") as caught:
         load_launch("a.launch", {"a.launch": bomb})
     assert caught.value.line == 2
+
+
+def test_rosparam_angles_as_rosparam_reads_them() -> None:
+    plan = launch(
+        """
+        <rosparam>
+          turn: deg(90)
+          half: rad(pi/2)
+          full: !radians 2*pi
+          back: !degrees -180
+          text: degrees
+        </rosparam>
+        """
+    )
+    assert plan.params["turn"] == pytest.approx(1.5707963267948966)
+    assert plan.params["half"] == pytest.approx(1.5707963267948966)
+    assert plan.params["full"] == pytest.approx(6.283185307179586)
+    assert plan.params["back"] == pytest.approx(-3.141592653589793)
+    assert plan.params["text"] == "degrees"
+    error = failure("<rosparam>a: !radians os.getcwd()</rosparam>\n")
+    assert "invalid angle" in str(error) and error.line == 2
+    error = failure("<rosparam>a: !!python/object:os.system x</rosparam>\n")
+    assert "not valid YAML" in str(error)
