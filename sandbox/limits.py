@@ -40,8 +40,11 @@ class Limits:
     first_step_budget_s: float = 10.0
     # How long an idle warm process may take to start and import numpy/matplotlib/skfuzzy.
     startup_budget_s: float = 30.0
-    # After Shutdown, time to run on_shutdown hooks, save figures and send artifacts.
-    shutdown_budget_s: float = 10.0
+    # The end budget: once a node has ended its part (signal_shutdown(), its script returned, or
+    # the run asked it to stop), time to run on_shutdown hooks, draw and save figures and send
+    # its files. Two 2400x1200 PNGs, as the CrowBot paper's scripts save, take ~2 s on a quiet
+    # 2-core machine and several times that under load; 30 s is generous and still bounded.
+    shutdown_budget_s: float = 30.0
     # Artifacts collected from the scratch directory at the end of a run.
     artifact_file_bytes: int = 8 * MiB
     artifact_total_bytes: int = 24 * MiB

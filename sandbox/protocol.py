@@ -55,10 +55,12 @@ class Outcome(StrEnum):
 
 
 class TopicDecl(msgspec.Struct, frozen=True):
-    """A topic and its ROS type name, e.g. ("Distance", "std_msgs/Int32")."""
+    """A topic and its ROS type name, e.g. ("Distance", "std_msgs/Int32"). `latch`: the
+    publisher's last message goes to every later subscriber too (rospy's latch=True)."""
 
     name: str
     type: str
+    latch: bool = False
 
 
 class RobotTopic(msgspec.Struct, frozen=True):

@@ -130,6 +130,7 @@ class NodeRuntime:
     _types: dict[str, str] = field(default_factory=dict)  # topic -> type, robot's and new ones
     _robot: dict[str, tuple[str, str]] = field(default_factory=dict)  # name -> (type, direction)
     _advertised: set[str] = field(default_factory=set)
+    _latched: set[str] = field(default_factory=set)
     _advertise_checked: dict[tuple[str, Any], str] = field(default_factory=dict)
     _subscribed: set[str] = field(default_factory=set)
     _new_advertised: list[TopicDecl] = field(default_factory=list)
@@ -249,8 +250,9 @@ class NodeRuntime:
             raise ROSException(f"topic '{name}' carries {known}, not {type_name}")
         return type_name
 
-    def advertise(self, topic: str, data_class: Any) -> str:
-        """Check that this node may publish `data_class` on `topic`; return the clean name."""
+    def advertise(self, topic: str, data_class: Any, latch: bool = False) -> str:
+        """Check that this node may publish `data_class` on `topic`; return the clean name.
+        `latch`: later subscribers get the last message too (rospy's latch=True)."""
         # Hot path: the step API and many scripts publish the same topic every period.
         checked = self._advertise_checked.get((topic, data_class))
         if checked is not None:
@@ -268,7 +270,12 @@ class NodeRuntime:
         self._types[name] = type_name
         if name not in self._advertised:
             self._advertised.add(name)
-            self._new_advertised.append(TopicDecl(name, type_name))
+            self._new_advertised.append(TopicDecl(name, type_name, latch))
+        elif latch and name not in self._latched:
+            self._new_advertised.append(TopicDecl(name, type_name, latch))
+        if latch:
+            self._latched.add(name)
+            return name  # not cached: the plain entry must not hide a later latch
         if isinstance(topic, str):
             self._advertise_checked[(topic, data_class)] = name
         return name

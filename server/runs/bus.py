@@ -26,6 +26,8 @@ class _Topic:
     subscribers: set[str] = field(default_factory=set)
     count: int = 0
     recent: deque = field(default_factory=lambda: deque(maxlen=RATE_WINDOW))
+    latched_by: set[str] = field(default_factory=set)  # publishers with latch=True
+    latched: dict[str, tuple[float, Envelope]] = field(default_factory=dict)  # their last
 
     def rate_hz(self) -> float | None:
         if len(self.recent) < 2 or self.recent[-1] <= self.recent[0]:
@@ -73,11 +75,18 @@ class TopicBus:
         """Record what a node said it publishes and subscribes to (from its Yield)."""
         for decl in advertised:
             self.declare_topic(decl.name, decl.type, node)
+            if decl.latch:
+                self.topics[decl.name].latched_by.add(node)
         for decl in subscribed:
             self.declare_topic(decl.name, decl.type)
-            self.topics[decl.name].subscribers.add(node)
-            self._inboxes[node].queues.setdefault(decl.name, deque(maxlen=QUEUE_SIZE))
+            topic = self.topics[decl.name]
+            topic.subscribers.add(node)
+            queue = self._inboxes[node].queues.setdefault(decl.name, deque(maxlen=QUEUE_SIZE))
             self.version += 1
+            # A latched topic's last message reaches a subscriber that comes late (rospy).
+            for publisher, (time_s, envelope) in sorted(topic.latched.items()):
+                if publisher != node:
+                    self._enqueue(self._inboxes[node], queue, time_s, envelope)
 
     def unsubscribe(self, node: str, names: list[str]) -> None:
         """The node stopped listening to `names`: nothing more is queued for it there."""
@@ -98,6 +107,9 @@ class TopicBus:
         self.unsubscribe(node, list(self._inboxes[node].queues))
         for topic in self.topics.values():
             topic.publishers.discard(node)
+            # rospy: a latched message lives as long as its publisher's node.
+            topic.latched_by.discard(node)
+            topic.latched.pop(node, None)
         self.version += 1
 
     def graph_topics(self) -> list[GraphTopic]:
@@ -121,6 +133,8 @@ class TopicBus:
         if publisher not in topic.publishers:
             topic.publishers.add(publisher)
             self.version += 1
+        if publisher in topic.latched_by:
+            topic.latched[publisher] = (time_s, envelope)
         topic.count += 1
         topic.recent.append(time_s)
         self._seq += 1
@@ -128,12 +142,20 @@ class TopicBus:
             if name == publisher:
                 continue
             inbox = self._inboxes[name]
-            queue = inbox.queues[envelope.topic]
-            if len(queue) == queue.maxlen:
-                inbox.dropped += 1
-                inbox.pending -= 1
-            queue.append((self._seq, time_s, envelope))
-            inbox.pending += 1
+            self._enqueue(inbox, inbox.queues[envelope.topic], time_s, envelope, self._seq)
+
+    def _enqueue(
+        self, inbox: _Inbox, queue: deque, time_s: float, envelope: Envelope, seq: int = 0
+    ) -> None:
+        """Queue one message for a subscriber (the oldest drops out of a full queue)."""
+        if not seq:
+            self._seq += 1
+            seq = self._seq
+        if len(queue) == queue.maxlen:
+            inbox.dropped += 1
+            inbox.pending -= 1
+        queue.append((seq, time_s, envelope))
+        inbox.pending += 1
 
     def has_pending(self, node: str) -> bool:
         return self._inboxes[node].pending > 0

@@ -247,3 +247,37 @@ def test_an_error_while_finishing_fails_the_run(tmp_path, launcher) -> None:
     result = crowbot_run(tmp_path, launcher, node(code, "n"), duration_s=2.0).execute()
     assert result.state is RunState.FAILED
     assert result.reason == "failed: node n raised ZeroDivisionError at line 4"
+
+
+LATCHER = """
+import rospy
+from std_msgs.msg import String
+rospy.init_node('map_maker')
+rospy.Publisher('map_name', String, queue_size=1, latch=True).publish("office")
+rospy.Publisher('news', String, queue_size=1).publish("old news")
+rospy.spin()
+"""
+
+LATE_LISTENER = """
+import rospy
+from std_msgs.msg import String
+rospy.init_node('late')
+rospy.sleep(1.0)
+rospy.Subscriber('map_name', String, lambda m: rospy.loginfo("latched %s", m.data))
+rospy.Subscriber('news', String, lambda m: rospy.loginfo("news %s", m.data))
+rospy.sleep(0.5)
+"""
+
+
+def test_a_latched_topic_reaches_a_late_subscriber(tmp_path, launcher) -> None:
+    result = crowbot_run(
+        tmp_path,
+        launcher,
+        node(LATCHER, "map_maker"),
+        node(LATE_LISTENER, "late"),
+        duration_s=2.0,
+    ).execute()
+    assert result.state is RunState.FINISHED, result.reason
+    log = log_of(tmp_path / "run", "late")
+    assert "latched office" in log
+    assert "news" not in log  # not latched: gone before the subscriber came

@@ -39,7 +39,7 @@ class Publisher:
         ):
             raise ROSException(f"queue_size must be a non-negative integer, got {queue_size!r}")
         self.queue_size = queue_size
-        self.name = node.advertise(name, data_class)
+        self.name = node.advertise(name, data_class, latch=bool(latch))
         self.resolved_name = "/" + self.name
         self.data_class = data_class
         self.type = data_class._type
