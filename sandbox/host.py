@@ -144,7 +144,7 @@ def _environment(stack: ExitStack, node: NodeRuntime, load: Load, workdir: str) 
     warnings.showwarning = _show_warning
     _install_logging(stack, node)
     if load.info.clock is Clock.LOCKSTEP:
-        stack.callback(TimePatch(node.clock, node.sleep_for).remove)
+        stack.callback(TimePatch(node.clock, node.sleep_for, node.poll).remove)
     runtime.activate(node)
     stack.callback(runtime.activate, None)
 

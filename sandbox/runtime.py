@@ -23,7 +23,7 @@ from __future__ import annotations
 import contextlib
 import difflib
 import sys
-import time
+import threading
 import traceback
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -45,7 +45,7 @@ from sandbox.protocol import (
 )
 from sandbox.services import NodeServices, is_internal
 from sandbox.timers import TimerSchedule
-from sandbox.vclock import NodeClock
+from sandbox.vclock import NodeClock, wall_monotonic_ns
 
 ANY_TYPE = "*"  # rospy.AnyMsg's type name
 WAKE_TOLERANCE_NS = 1_000  # [ns] a wake this close to the target counts as on time (float s)
@@ -140,10 +140,13 @@ class NodeRuntime:
     _callback_depth: int = 0
     _in_hooks: bool = False
     _warned_names: set[str] = field(default_factory=set)
-    # The outbox keeps at most a publisher's queue_size messages per topic (oldest dropped, as
-    # rospy's publisher queue): entries are None once dropped.
+    # The outbox keeps at most a publisher's queue_size messages per topic and burst (oldest
+    # dropped, as rospy's publisher queue): entries are None once dropped. A burst is what one
+    # callback, or the main loop between two waits, publishes: in rospy callbacks run as their
+    # messages arrive, spread in time, so the queue's writer drains between them.
     _outbox_slots: list[Envelope | None] = field(default_factory=list)
-    _outbox_by_topic: dict[str, list[int]] = field(default_factory=dict)
+    _outbox_by_topic: dict[tuple[str, int], list[int]] = field(default_factory=dict)
+    _burst: int = 0
     _unsubscribed: list[str] = field(default_factory=list)
     graph: list[GraphTopic] | None = None  # the run's topics, as of the last wake that sent it
     timers: TimerSchedule = field(default_factory=TimerSchedule)
@@ -151,6 +154,8 @@ class NodeRuntime:
     wake_topics: set[str] = field(default_factory=set)  # always wake early (service requests)
     names: Names | None = None  # ROS name resolution for this node (sandbox.names)
     _polls: int = 0
+    _waiting: bool = False
+    _main_thread: int = field(default_factory=threading.get_ident)
     _woken_ns: int = 0
     _woken_wall_s: float = 0.0
 
@@ -160,7 +165,7 @@ class NodeRuntime:
             self._types[topic.name] = topic.type
         self.params = {normalize_param(key): value for key, value in self.info.params.items()}
         self._woken_ns = self.clock.now_ns()
-        self._woken_wall_s = time.monotonic()
+        self._woken_wall_s = _wall_s()
         if self.names is None:
             self.names = Names.from_info(self.info)
 
@@ -326,9 +331,10 @@ class NodeRuntime:
             data = message.serialize()
         except Exception as error:
             raise ROSSerializationException(f"publish() on '{topic}': {error}") from None
-        indexes = self._outbox_by_topic.get(topic)
+        key = (topic, self._burst)
+        indexes = self._outbox_by_topic.get(key)
         if indexes is None:
-            indexes = self._outbox_by_topic[topic] = []
+            indexes = self._outbox_by_topic[key] = []
         indexes.append(len(self._outbox_slots))
         self._outbox_slots.append(Envelope(topic, message._type, data))
         if queue_size and len(indexes) > queue_size:
@@ -348,11 +354,15 @@ class NodeRuntime:
         self._polls += 1
         if self._polls <= FREE_POLLS or self._callback_depth or self.shutdown is not None:
             return
+        if self._waiting:
+            return  # a clock read inside our own wait (the link, logging) is not the student's
+        if threading.get_ident() != self._main_thread:
+            return  # only the node's own thread may talk to the parent
         if self.info.clock is Clock.LOCKSTEP:
             self.clock.advance_ns(POLL_COST_NS)
             if self.clock.now_ns() - self._woken_ns < BUSY_SLICE_NS:
                 return
-        elif time.monotonic() - self._woken_wall_s < REALTIME_BUSY_SLICE_S:
+        elif _wall_s() - self._woken_wall_s < REALTIME_BUSY_SLICE_S:
             return
         # The run may end meanwhile: is_shutdown() says so from now on.
         with contextlib.suppress(ROSInterruptException):
@@ -396,6 +406,7 @@ class NodeRuntime:
 
     def _run_student(self, function: Callable[..., Any], *args: Any) -> None:
         """Call student code from inside a sleep; its exception ends the node."""
+        self._burst += 1
         self._callback_depth += 1
         try:
             function(*args)
@@ -452,18 +463,21 @@ class NodeRuntime:
             unsubscribed=self._unsubscribed,
         )
         self._new_advertised, self._new_subscribed, self._unsubscribed = [], [], []
+        self._waiting = True
         try:
             self.link.send(frame)
             reply = self.link.receive()
         except ProtocolError as error:
             raise LinkLost(error) from error
+        finally:
+            self._waiting = False
         if isinstance(reply, Shutdown):
             self.signal_shutdown(reply.reason, by_parent=True)
             raise ROSInterruptException(f"ROS shutdown request: {reply.reason}")
         if not isinstance(reply, Wake):
             raise LinkLost(ProtocolError(f"expected Wake or Shutdown, got {type(reply).__name__}"))
         self.clock.wake(reply.time_s)
-        self._polls, self._woken_ns, self._woken_wall_s = 0, self.clock.now_ns(), time.monotonic()
+        self._polls, self._woken_ns, self._woken_wall_s = 0, self.clock.now_ns(), _wall_s()
         if reply.graph is not None:
             self.graph = reply.graph
         self._deliver(reply.deliveries)
@@ -473,6 +487,7 @@ class NodeRuntime:
                     self._run_student(timer.fire, self.clock.now_ns())
                 if self.shutdown is not None:
                     break
+        self._burst += 1  # back in the main loop
         if self.shutdown is not None:  # a callback called signal_shutdown()
             raise ROSInterruptException(f"ROS shutdown request: {self.shutdown.reason}")
 
@@ -524,6 +539,11 @@ class NodeRuntime:
 
     def warn(self, text: str) -> None:
         self.log("WARN", text)
+
+
+def _wall_s() -> float:
+    """The real monotonic clock [s] (the `time` module's is the node's clock in lockstep)."""
+    return wall_monotonic_ns() / 1e9
 
 
 def _callable_name(function: Any) -> str:

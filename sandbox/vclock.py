@@ -23,7 +23,7 @@ from numbers import Real
 
 from sandbox.protocol import Clock
 
-_real_monotonic_ns = time.monotonic_ns
+wall_monotonic_ns = time.monotonic_ns
 _PATCHED = (
     "time",
     "time_ns",
@@ -45,13 +45,13 @@ class NodeClock:
     def __init__(self, mode: Clock, start_time_s: float) -> None:
         self.mode = mode
         self._anchor_ns = seconds_to_ns(start_time_s)  # run time at the last wake
-        self._anchor_wall_ns = _real_monotonic_ns()
+        self._anchor_wall_ns = wall_monotonic_ns()
         self._last_ns = self._anchor_ns  # never hand out a time earlier than one already given
 
     def now_ns(self) -> int:
         now = self._anchor_ns
         if self.mode is Clock.REALTIME:
-            now += _real_monotonic_ns() - self._anchor_wall_ns
+            now += wall_monotonic_ns() - self._anchor_wall_ns
         if now < self._last_ns:
             now = self._last_ns
         self._last_ns = now
@@ -67,7 +67,7 @@ class NodeClock:
 
     def wake(self, time_s: float) -> None:
         self._anchor_ns = max(seconds_to_ns(time_s), self.now_ns())
-        self._anchor_wall_ns = _real_monotonic_ns()
+        self._anchor_wall_ns = wall_monotonic_ns()
 
 
 class TimePatch:
@@ -76,13 +76,21 @@ class TimePatch:
     Process-wide while installed: the child runs one node, so every thread sees node time.
     """
 
-    def __init__(self, clock: NodeClock, sleep: Callable[[float], None]) -> None:
+    def __init__(
+        self,
+        clock: NodeClock,
+        sleep: Callable[[float], None],
+        poll: Callable[[], None] = lambda: None,
+    ) -> None:
         self._saved = {name: getattr(time, name) for name in _PATCHED}
 
+        # `poll`: a loop that spins on time.time() lets simulated time pass (sandbox.runtime).
         def time_s() -> float:
+            poll()
             return clock.now_ns() / 1e9
 
         def time_ns() -> int:
+            poll()
             return clock.now_ns()
 
         def sleep_s(seconds: float) -> None:

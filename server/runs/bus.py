@@ -53,6 +53,7 @@ class TopicBus:
         self._inboxes: dict[str, _Inbox] = {}
         self._seq = 0
         self.version = 0  # bumped whenever a node, a publisher or a subscriber comes or goes
+        self._ended: set[str] = set()  # nodes that ended: not routed to, not in graph_topics
 
     # ----------------------------------------------------------------------------- graph
     def add_node(self, name: str) -> None:
@@ -101,21 +102,32 @@ class TopicBus:
             self.version += 1
 
     def remove_node(self, node: str) -> None:
-        """A node ended: it no longer subscribes or publishes (services it served are gone)."""
-        if node not in self._inboxes:
+        """A node ended: nothing more is queued for it, and the nodes still running no longer
+        see it in the graph (services it served are gone). The run's graph keeps it: it shows
+        what talked to what over the whole run."""
+        inbox = self._inboxes.get(node)
+        if inbox is None or node in self._ended:
             return
-        self.unsubscribe(node, list(self._inboxes[node].queues))
+        self._ended.add(node)
+        for queue in inbox.queues.values():
+            queue.clear()
+        inbox.pending = 0
         for topic in self.topics.values():
-            topic.publishers.discard(node)
             # rospy: a latched message lives as long as its publisher's node.
             topic.latched_by.discard(node)
             topic.latched.pop(node, None)
         self.version += 1
 
     def graph_topics(self) -> list[GraphTopic]:
-        """The graph as nodes see it (rospy.get_published_topics, services)."""
+        """The graph as running nodes see it (rospy.get_published_topics, services)."""
+        ended = self._ended
         return [
-            GraphTopic(name, topic.type, sorted(topic.publishers), sorted(topic.subscribers))
+            GraphTopic(
+                name,
+                topic.type,
+                sorted(topic.publishers - ended),
+                sorted(topic.subscribers - ended),
+            )
             for name, topic in sorted(self.topics.items())
         ]
 
@@ -139,7 +151,7 @@ class TopicBus:
         topic.recent.append(time_s)
         self._seq += 1
         for name in topic.subscribers:
-            if name == publisher:
+            if name == publisher or name in self._ended:
                 continue
             inbox = self._inboxes[name]
             self._enqueue(inbox, inbox.queues[envelope.topic], time_s, envelope, self._seq)
@@ -156,6 +168,11 @@ class TopicBus:
             inbox.pending -= 1
         queue.append((seq, time_s, envelope))
         inbox.pending += 1
+
+    def has_subscribers(self, name: str) -> bool:
+        """Does a running node subscribe to topic `name`?"""
+        topic = self.topics.get(name)
+        return topic is not None and bool(topic.subscribers - self._ended)
 
     def has_pending(self, node: str) -> bool:
         return self._inboxes[node].pending > 0

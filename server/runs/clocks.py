@@ -62,7 +62,7 @@ def run_lockstep(run: Run) -> None:
 
 def _next_event_ns(run: Run) -> int:
     candidates = [run.duration_ns]
-    for upcoming in (run.next_script_ns(), run.next_builtin_ns()):
+    for upcoming in (run.next_script_ns(), run.next_builtin_ns(), run.next_tf_ns()):
         if upcoming is not None:
             candidates.append(upcoming)
     spinning = False
@@ -119,7 +119,11 @@ class RealtimeDriver:
             for s in order
             if not s.done and s.process is not None and s.process.state == "running"
         ]
-        upcoming = [t for t in (run.next_script_ns(), run.next_builtin_ns()) if t is not None]
+        upcoming = [
+            t
+            for t in (run.next_script_ns(), run.next_builtin_ns(), run.next_tf_ns())
+            if t is not None
+        ]
         next_ns = min(
             [run.duration_ns, round(run.sim.next_publication_s() * NS)]
             + upcoming

@@ -485,6 +485,11 @@ class Run(RunControls, RunOutputs):
     def next_builtin_ns(self) -> int | None:
         return self.builtins.next_ns()
 
+    def next_tf_ns(self) -> int | None:
+        """When /tf is next due, if a node listens to it (then the clocks stop there, so a
+        tf listener gets the tree at 30 Hz in lockstep too); None if nobody listens."""
+        return self._next_tf_ns if self.bus.has_subscribers(TF_TOPIC) else None
+
     # ----------------------------------------------------------------------------- simulation
     def advance_to(self, time_ns: int) -> None:
         """Step the robot to run time `time_ns`, routing what it publishes."""

@@ -281,3 +281,16 @@ def test_a_latched_topic_reaches_a_late_subscriber(tmp_path, launcher) -> None:
     log = log_of(tmp_path / "run", "late")
     assert "latched office" in log
     assert "news" not in log  # not latched: gone before the subscriber came
+
+
+def test_a_tf_listener_gets_the_tree_at_30_hz_in_lockstep(tmp_path, launcher) -> None:
+    code = TF_READER.replace(
+        "rospy.sleep(0.5)",
+        "count = [0]\nrospy.Subscriber('tf', TFMessage, "
+        "lambda m: count.__setitem__(0, count[0] + 1))\nrospy.sleep(1.0)\n"
+        "rospy.loginfo('tf messages %d', count[0])",
+    )
+    result = crowbot_run(tmp_path, launcher, node(code, "tf_reader"), duration_s=2.0).execute()
+    assert result.state is RunState.FINISHED, result.reason
+    count = int(log_of(tmp_path / "run", "tf_reader").split("tf messages ")[1].split()[0])
+    assert 28 <= count <= 31  # 1 s of a 30 Hz tree, though the node sleeps for a whole second

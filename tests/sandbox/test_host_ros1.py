@@ -332,3 +332,17 @@ def test_rospy_exceptions_module_and_any_msg(
     exited = parent.wake(0.1, [envelope("Distance", Int32(7))])
     assert exited.outcome is Outcome.FINISHED, exited.error
     assert "std_msgs/Int32 4 bytes" in capsys.readouterr().out
+
+
+def test_a_loop_spinning_on_time_time_ends_in_lockstep(tmp_path: Path) -> None:
+    yields, exited = run(
+        """
+        import time
+        start = time.time()
+        while time.time() - start < 0.2:
+            pass
+        """,
+        tmp_path,
+    )
+    assert exited.outcome is Outcome.FINISHED, exited.error
+    assert yields[-1].wake_at_s == pytest.approx(0.2, abs=0.002)
