@@ -143,8 +143,8 @@ def _environment(stack: ExitStack, node: NodeRuntime, load: Load, workdir: str) 
     warnings.simplefilter("default")
     warnings.showwarning = _show_warning
     _install_logging(stack, node)
-    if load.info.clock is Clock.LOCKSTEP:
-        stack.callback(TimePatch(node.clock, node.sleep_for, node.poll).remove)
+    lockstep = load.info.clock is Clock.LOCKSTEP
+    stack.callback(TimePatch(node.clock, node.sleep_for, node.poll, clocks=lockstep).remove)
     runtime.activate(node)
     stack.callback(runtime.activate, None)
 

@@ -17,6 +17,7 @@ Time is kept in integer nanoseconds so that periods add up without floating-poin
 
 from __future__ import annotations
 
+import threading
 import time
 from collections.abc import Callable
 from numbers import Real
@@ -81,8 +82,14 @@ class TimePatch:
         clock: NodeClock,
         sleep: Callable[[float], None],
         poll: Callable[[], None] = lambda: None,
+        clocks: bool = True,
     ) -> None:
+        """`clocks` False (a realtime run): only time.sleep() is the node's (so callbacks run
+        while a script sleeps with it, as rospy's threads would run them); the clock functions
+        stay the wall clock."""
         self._saved = {name: getattr(time, name) for name in _PATCHED}
+        real_sleep = self._saved["sleep"]
+        main_thread = threading.get_ident()
 
         # `poll`: a loop that spins on time.time() lets simulated time pass (sandbox.runtime).
         def time_s() -> float:
@@ -100,6 +107,9 @@ class TimePatch:
                 )
             if seconds < 0:
                 raise ValueError("sleep length must be non-negative")
+            if threading.get_ident() != main_thread:
+                real_sleep(seconds)  # a student's own thread: only the node's may yield
+                return
             sleep(float(seconds))
 
         replacements = {
@@ -111,6 +121,8 @@ class TimePatch:
             "perf_counter_ns": time_ns,
             "sleep": sleep_s,
         }
+        if not clocks:
+            replacements = {"sleep": sleep_s}
         for name, function in replacements.items():
             function.__name__ = name
             function.__qualname__ = name

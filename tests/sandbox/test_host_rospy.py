@@ -102,7 +102,7 @@ def test_course_script_runs_unchanged_in_lockstep(
     assert [float(row["period_s"]) for row in rows] == pytest.approx([0.1] * 16, abs=1e-9)
 
 
-def test_realtime_leaves_the_time_module_alone(tmp_path: Path) -> None:
+def test_realtime_leaves_the_time_modules_clocks_alone(tmp_path: Path) -> None:
     parent = Parent(
         """
         import time
@@ -352,3 +352,26 @@ def test_the_students_own_logging_config_wins(
     )
     assert exited.outcome is Outcome.FINISHED, exited.error
     assert capsys.readouterr().out.splitlines() == ["mine!"]
+
+
+def test_realtime_time_sleep_lets_callbacks_run(tmp_path: Path) -> None:
+    parent = Parent(
+        """
+        import time
+        import rospy
+        from std_msgs.msg import Int32
+        seen = []
+        rospy.init_node("sleeper")
+        rospy.Subscriber("Distance", Int32, lambda m: seen.append(m.data))
+        time.sleep(3.0)   # longer than the step budget: a sleep, not a computation
+        assert seen == [42], seen
+        """,
+        tmp_path,
+        info=crowbot_info(clock=Clock.REALTIME, start_time_s=0.0),
+    )
+    first = parent.next()
+    assert isinstance(first, Yield) and first.wake_at_s == pytest.approx(3.0, abs=0.5)
+    frame = parent.wake(1.0, [envelope("Distance", Int32(42))])
+    assert isinstance(frame, Yield)
+    exited = parent.wake(frame.wake_at_s)
+    assert exited.outcome is Outcome.FINISHED, exited.error
