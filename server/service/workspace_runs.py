@@ -7,11 +7,13 @@ robot, never another student's files, so "launch someone else's workspace" canno
 
 from __future__ import annotations
 
+import logging
+import uuid
 from collections.abc import Mapping
 
 from sqlalchemy.orm import Session as Db
 
-from server.runs.spec import NodeSpec
+from server.runs.launch import LaunchFileError, LaunchPlan, load_launch
 from server.service import exercises, workspace_files
 from server.service.catalog import UnknownIdError
 from server.service.runs import RunRequestError
@@ -19,6 +21,7 @@ from server.sim import robot_ids
 from server.store import workspaces as store
 
 LAUNCH_EXTENSIONS = (".launch", ".xml")
+log = logging.getLogger("robodojo.service")
 
 
 def starter_files(db: Db, workspace: str) -> list[tuple[str, str]]:
@@ -43,12 +46,10 @@ def contents(db: Db, user_id: str, workspace: str) -> dict[str, str]:
     return files
 
 
-def launch_nodes(
-    files: Mapping[str, str], launch_file: str, args: Mapping[str, str]
-) -> tuple[tuple[NodeSpec, ...], dict[str, object]]:
-    """The nodes (with their params, remaps, args and namespaces) and the global parameters of
-    a launch file of the workspace `files`; RunRequestError (a 422) with the reader's sentence,
-    which names the file and line, for anything wrong in it."""
+def launch_plan(files: Mapping[str, str], launch_file: str, args: Mapping[str, str]) -> LaunchPlan:
+    """The nodes (with their params, remaps, args and namespaces), the global parameters and
+    the reader's notes of a launch file of the workspace `files`; LaunchFileError (a 422 with
+    the reader's sentence, which names the file and the line) for anything wrong in it."""
     name = workspace_files.file_name(launch_file)
     if not name.endswith(LAUNCH_EXTENSIONS):
         raise RunRequestError(
@@ -60,10 +61,17 @@ def launch_nodes(
             f"there is no launch file '{name}' in your workspace; "
             + (f"its launch files: {', '.join(found)}" if found else "it has no launch file yet")
         )
-    from server.runs.launch import LaunchFileError, load_launch
-
     try:
-        plan = load_launch(name, files, dict(args))
-    except LaunchFileError as error:
-        raise RunRequestError(str(error)) from None
-    return tuple(plan.nodes), dict(plan.params)
+        return load_launch(name, files, dict(args))
+    except LaunchFileError:
+        raise
+    except Exception as error:  # a fault of the reader: the student still gets a sentence
+        incident = uuid.uuid4().hex[:8]
+        log.exception("incident %s: the launch reader failed on %s", incident, name)
+        raise LaunchFileError(
+            name,
+            None,
+            f"this launch file could not be read ({type(error).__name__}; incident {incident}, "
+            "logged): check that it is well-formed roslaunch XML, and tell your instructor the "
+            "incident number",
+        ) from None

@@ -18,6 +18,7 @@ from sandbox.protocol import Clock
 from server.api.auth import Caller, current_user
 from server.api.schemas import RunCommand, RunCreate
 from server.runs.export import csv_file_name, export_csv
+from server.runs.launch import LaunchPlan
 from server.runs.recorder import ARTIFACTS_DIR, LOGS_DIR, RECORDING_FILE
 from server.runs.safe_paths import inside, safe_relative_path
 from server.runs.spec import NodeSpec
@@ -121,7 +122,7 @@ def create(body: RunCreate, request: Request, caller: Caller = Depends(current_u
             )
         catalog.check_robot(body.robot)
         catalog.check_world(body.world)
-    nodes, params, files = _nodes_and_files(request, caller, body, entry)
+    nodes, plan, files = _nodes_and_files(request, caller, body, entry)
     gated = request.app.state.settings.hardware_gate and (
         entry is None or entry.exercise.hardware_gate
     )
@@ -145,18 +146,21 @@ def create(body: RunCreate, request: Request, caller: Caller = Depends(current_u
         clock=Clock(body.clock) if body.clock else None,
         duration_s=body.duration,
         seed=body.seed,
-        params=params,
+        params=dict(plan.params) if plan else {},
         files=files,
     )
     record = service.start(caller.id, request_)
-    return run_out(record, service)
+    out = run_out(record, service)
+    if plan is not None:
+        out["launch"] = {"file": body.launch.file, "notes": list(plan.notes)}
+    return out
 
 
 def _nodes_and_files(
     request: Request, caller: Caller, body: RunCreate, entry
-) -> tuple[tuple[NodeSpec, ...], dict[str, object], tuple[tuple[str, bytes], ...]]:
-    """The nodes (sent, or named by a launch file of the caller's workspace), the launch
-    file's global parameters and the workspace's data files for every node."""
+) -> tuple[tuple[NodeSpec, ...], LaunchPlan | None, tuple[tuple[str, bytes], ...]]:
+    """The nodes (sent, or named by a launch file of the caller's workspace), the launch plan
+    (global parameters, notes) and the workspace's data files for every node."""
     workspace = body.workspace
     if workspace is None and body.launch is not None:
         workspace = entry.exercise.id if entry else body.robot
@@ -164,9 +168,10 @@ def _nodes_and_files(
     if workspace is not None:
         with request.app.state.store.session() as db:
             files = workspace_runs.contents(db, caller.id, workspace)
-    params: dict[str, object] = {}
+    plan = None
     if body.launch is not None:
-        nodes, params = workspace_runs.launch_nodes(files, body.launch.file, body.launch.args)
+        plan = workspace_runs.launch_plan(files, body.launch.file, body.launch.args)
+        nodes = plan.nodes
     else:
         nodes = tuple(
             node_spec(
@@ -179,7 +184,7 @@ def _nodes_and_files(
             )
             for n in body.nodes or ()
         )
-    return nodes, params, workspace_files.data_files(files.items())
+    return nodes, plan, workspace_files.data_files(files.items())
 
 
 @router.get("", summary="My runs, newest first")
