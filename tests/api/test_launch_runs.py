@@ -83,10 +83,8 @@ def test_an_exercise_launch_uses_the_exercise_workspace_and_its_starter_files(la
     node = starter[0]["name"]
     text = f'<launch>\n  <node pkg="pid" type="{node}.py" name="{node}"/>\n</launch>\n'
     workspace(student, {"pid.launch": text}, "crowbot_distance_pid")
-    answer = student.post(
-        "/api/runs",
-        json={"exercise": "crowbot_distance_pid", "duration": 1.0, "launch": {"file": "pid.launch"}},
-    )
+    body = {"exercise": "crowbot_distance_pid", "duration": 1.0, "launch": {"file": "pid.launch"}}
+    answer = student.post("/api/runs", json=body)
     assert answer.status_code == 201, answer.text
     run = wait_for_end(student, answer.json()["id"])
     assert [n["name"] for n in run["code"]] == [node]

@@ -1,8 +1,9 @@
 // The code editor: CodeMirror 6 with Python, a tab per node file of the workspace, each with its
 // own undo history; edits are saved to the workspace a moment after typing stops (each save is
-// a version on the server). Ctrl/Cmd+S saves now, Ctrl/Cmd+Enter runs. "+ Node" adds a file; a
-// file the student added (not the exercise's starter) can be deleted with its versions (the
-// tab's x, or Delete on the tab). A run opened by its id (app.watching) shows that run's code
+// a version on the server). Ctrl/Cmd+S saves now, Ctrl/Cmd+Enter runs. "+ Node" adds a node
+// file; "+ File" adds a data file (CSV, YAML, JSON, TXT, a launch file), empty or uploaded,
+// edited as text; a file the student added (not the exercise's starter) can be deleted with its
+// versions (the tab's x, or Delete on the tab). A run opened by its id (app.watching) shows that run's code
 // read-only instead of a workspace.
 
 import { closeBrackets, closeBracketsKeymap } from "@codemirror/autocomplete";
@@ -29,11 +30,15 @@ import {
 } from "@codemirror/view";
 import { api } from "../common/api.js";
 import { byId, debounce, fill, h, when } from "../common/dom.js";
-import { app, fileOf, nodeOf, on } from "./state.js";
+import { app, emit, fileOf, isLaunchFile, isNodeFile, nodeOf, on } from "./state.js";
 
 const AUTOSAVE_MS = 1200; // [ms] after the last keystroke; each save is a version on the server
 const MAX_NODES = 8; // the API's limit of nodes in one run
 const NODE_NAME = /^[A-Za-z][A-Za-z0-9_]{0,39}$/;
+// A data file's path as the server takes it (server/service/workspace_files.py): at most two
+// folders, parts of letters, digits, _ - and ., and one of these endings.
+const DATA_FILE = /^([A-Za-z0-9_][A-Za-z0-9_.-]*\/){0,2}[A-Za-z0-9_][A-Za-z0-9_.-]*\.(csv|ya?ml|json|txt|launch|xml)$/i;
+const MAX_DATA_BYTES = 1024 * 1024; // [B] the server's default cap per data file
 
 const tabsElement = byId("file-tabs");
 const statusElement = byId("save-status");
@@ -65,16 +70,31 @@ export function pythonExtensions({ readOnly = false, label = "Python code" } = {
   ];
 }
 
+/** A data file (CSV, YAML, a launch file): text without Python's highlighting, two-space indent. */
+function textExtensions({ readOnly = false, label }) {
+  return [
+    lineNumbers(),
+    highlightActiveLineGutter(),
+    highlightSpecialChars(),
+    drawSelection(),
+    indentUnit.of("  "),
+    highlightSelectionMatches(),
+    EditorState.readOnly.of(readOnly),
+    EditorView.contentAttributes.of(readOnly ? { "aria-label": label, "aria-readonly": "true" } : { "aria-label": label }),
+  ];
+}
+
 function fileExtensions(filename, { readOnly: locked = false } = {}) {
+  const language = filename.endsWith(".py") ? pythonExtensions : textExtensions;
   if (locked) {
     return [
-      pythonExtensions({ readOnly: true, label: `Code of ${filename} in the run on show (read only)` }),
+      language({ readOnly: true, label: `Code of ${filename} in the run on show (read only)` }),
       search({ top: true }),
       keymap.of([...defaultKeymap, ...searchKeymap]),
     ];
   }
   return [
-    pythonExtensions({ label: `Code of ${filename} (Escape then Tab leaves the editor)` }),
+    language({ label: `${filename.endsWith(".py") ? "Code" : "Text"} of ${filename} (Escape then Tab leaves the editor)` }),
     history(),
     dropCursor(),
     EditorState.allowMultipleSelections.of(true),
@@ -114,17 +134,30 @@ export function initEditor({ run }) {
     confirmDelete(cross.dataset.file);
   });
   initAddNode();
+  initAddFile();
   window.addEventListener("beforeunload", () => {
     for (const file of files.values()) if (isDirty(file)) save(file, { keepalive: true });
   });
 }
 
-/** The code of every node, in tab order: what a run is started with. An emptied file is left
- * out (files cannot be deleted from a workspace). */
+/** The code of every node (the .py files at the top of the workspace), in tab order: what a
+ * run is started with. An emptied file is left out. Data files reach the nodes through the
+ * workspace (`workspace` in POST /api/runs). */
 export function nodes() {
   return [...files.values()]
+    .filter((file) => isNodeFile(file.filename))
     .map((file) => ({ name: nodeOf(file.filename), code: code(file) }))
     .filter((node) => node.code.trim() !== "");
+}
+
+/** The workspace's launch files (.launch, .xml), in tab order. */
+export function launchFiles() {
+  return readOnly ? [] : [...files.keys()].filter(isLaunchFile);
+}
+
+/** The workspace on show (null while a run's code is shown read only). */
+export function workspaceName() {
+  return workspace;
 }
 
 /** Edited since the last save (starter code nobody touched is not saved). */
@@ -184,6 +217,9 @@ function setReadOnly(locked) {
   addButton.hidden = locked;
   byId("add-node-form").hidden = true;
   addButton.setAttribute("aria-expanded", "false");
+  byId("add-file").hidden = locked;
+  byId("add-file").setAttribute("aria-expanded", "false");
+  byId("add-file-form").hidden = true;
   versionsButton.disabled = locked;
 }
 
@@ -200,6 +236,7 @@ function addFile(filename, text, version, savedAt, { readOnly: locked = false } 
   file.autosave = debounce(() => save(file), AUTOSAVE_MS);
   files.set(filename, file);
   renderTabs();
+  emit("files", { names: [...files.keys()] });
   return file;
 }
 
@@ -282,6 +319,7 @@ function show(filename) {
   view.setState(files.get(filename).state);
   renderTabs();
   showStatus();
+  emit("file-shown", { filename });
 }
 
 function edited(filename) {
@@ -419,6 +457,7 @@ async function deleteFile(filename) {
   const names = [...files.keys()];
   const index = names.indexOf(filename);
   files.delete(filename);
+  emit("files", { names: [...files.keys()] });
   if (current === filename) {
     current = null;
     show(names[index + 1] || names[index - 1]);
@@ -489,7 +528,7 @@ function initAddNode() {
     let problem = null;
     if (!NODE_NAME.test(name)) problem = "a node name starts with a letter, then letters, digits or _ (at most 40)";
     else if (files.has(fileOf(name))) problem = `there is already a node '${name}'`;
-    else if (files.size >= MAX_NODES) problem = `a run has at most ${MAX_NODES} nodes`;
+    else if ([...files.keys()].filter(isNodeFile).length >= MAX_NODES) problem = `a run has at most ${MAX_NODES} nodes`;
     input.setCustomValidity(problem || "");
     if (problem) {
       input.reportValidity();
@@ -505,6 +544,87 @@ function initAddNode() {
     view.focus();
   });
   input.addEventListener("input", () => input.setCustomValidity(""));
+}
+
+/** A skeleton for a new data file: a launch file gets a node to start from. */
+function dataTemplate(name) {
+  if (!isLaunchFile(name)) return "";
+  const node = [...files.keys()].find(isNodeFile) || "controller.py";
+  return `<launch>
+  <node pkg="my_pkg" type="${node}" name="${nodeOf(node)}" output="screen">
+    <!-- <param name="speed" value="0.2"/> -->
+  </node>
+</launch>
+`;
+}
+
+/** "+ File": a data file by name (empty, or a launch file's skeleton), or one uploaded from
+ * the computer (read as text; the server refuses binary files with a sentence). */
+function initAddFile() {
+  const button = byId("add-file");
+  const form = byId("add-file-form");
+  const input = byId("add-file-name");
+  const upload = byId("add-file-upload");
+  const close = () => {
+    form.hidden = true;
+    button.setAttribute("aria-expanded", "false");
+  };
+  button.addEventListener("click", () => {
+    form.hidden = !form.hidden;
+    button.setAttribute("aria-expanded", String(!form.hidden));
+    if (!form.hidden) input.focus();
+  });
+  form.addEventListener("keydown", (event) => {
+    if (event.key === "Escape") {
+      close();
+      button.focus();
+    }
+  });
+  const problemOf = (name) => {
+    if (name.startsWith("/") || name.split("/").some((part) => part.startsWith("."))) return "a file stays inside the workspace: no hidden files, '..' or leading '/'";
+    if (!DATA_FILE.test(name)) return "a data file's name ends .csv, .yaml, .json, .txt, .launch or .xml (folders: config/gains.yaml)";
+    return null;
+  };
+  form.addEventListener("submit", (event) => {
+    event.preventDefault();
+    const name = input.value.trim();
+    const problem = problemOf(name) || (files.has(name) ? `there is already a file '${name}'` : null);
+    input.setCustomValidity(problem || "");
+    if (problem) {
+      input.reportValidity();
+      return;
+    }
+    createFile(name, dataTemplate(name));
+    input.value = "";
+    close();
+    view.focus();
+  });
+  input.addEventListener("input", () => input.setCustomValidity(""));
+  upload.addEventListener("change", async () => {
+    const chosen = upload.files?.[0];
+    upload.value = "";
+    if (!chosen) return;
+    const name = chosen.name.replace(/\s+/g, "_");
+    let problem = /^[A-Za-z][A-Za-z0-9_]{0,39}\.py$/.test(name) ? null : problemOf(name); // a node, or data
+    if (!problem && chosen.size > MAX_DATA_BYTES) problem = `${name} has ${chosen.size} bytes; the limit is ${MAX_DATA_BYTES}`;
+    if (problem) {
+      setStatus(`Not uploaded: ${problem}`, true);
+      return;
+    }
+    const text = await chosen.text();
+    close();
+    if (files.has(name)) {
+      show(name);
+      replaceCurrent(text); // an edit: saved as the file's next version
+    } else createFile(name, text);
+  });
+}
+
+function createFile(name, text) {
+  const file = addFile(name, text, 0, null);
+  file.edited = true;
+  show(name);
+  save(file);
 }
 
 export function focusEditor() {

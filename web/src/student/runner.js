@@ -1,6 +1,8 @@
 // Run controls and the run on show: start a run in simulation (clock, duration, seed; in free
 // play optionally with the teleop node, "Drive with arrow keys") or on a bench robot
 // (startOnRobot: realtime, the hardware panel's "Run on the real robot"), stop,
+// what to run ("my nodes" with optional params, or a launch file of the workspace: opening a
+// launch file's tab chooses it), stop,
 // pause/resume (lockstep only), the progress of simulated time, the state and why it ended,
 // and the checks. A live run is followed over its websocket and its record polled for the
 // figures the websocket does not carry (node periods, time).
@@ -8,8 +10,9 @@
 import { api } from "../common/api.js";
 import { byId, fill, h } from "../common/dom.js";
 import { LiveRun } from "../common/live.js";
-import { flushAll, nodes } from "./editor.js";
-import { app, applyWants, emit, END_STATES, on } from "./state.js";
+import { flushAll, launchFiles, nodes, workspaceName } from "./editor.js";
+import { parseParams } from "./params.js";
+import { app, applyWants, emit, END_STATES, isLaunchFile, on } from "./state.js";
 
 const POLL_MS = 1000; // [ms] the run's record while it is live: time, node periods
 const END_WAIT_MS = 15000; // [ms] how long to wait for an ended run's checks to be stored
@@ -20,6 +23,9 @@ const durationInput = byId("run-duration");
 const seedInput = byId("run-seed");
 const teleopOption = byId("teleop-option");
 const teleopInput = byId("run-teleop");
+const whatInput = byId("run-what");
+const paramsOption = byId("run-params-option");
+const paramsInput = byId("run-params");
 const TELEOP_KEY = "robodojo.teleop";
 const runButton = byId("run-button");
 const pauseButton = byId("pause-button");
@@ -52,7 +58,32 @@ export function initRunner() {
     teleopOption.hidden = Boolean(target.exercise) || Boolean(app.watching); // exercises say
     forget();
   });
+  on("files", fillWhat);
+  on("file-shown", ({ filename }) => {
+    if (isLaunchFile(filename)) {
+      fillWhat();
+      whatInput.value = filename;
+      paramsOption.hidden = true;
+    }
+  });
+  whatInput.addEventListener("change", () => {
+    paramsOption.hidden = whatInput.value !== "";
+  });
+  paramsInput.addEventListener("input", () => paramsInput.setCustomValidity(""));
   controls();
+}
+
+/** "Run: my nodes" or one of the workspace's launch files; the choice is kept if it remains. */
+function fillWhat() {
+  const chosen = whatInput.value;
+  const launches = launchFiles();
+  fill(
+    whatInput,
+    h("option", { value: "" }, "my nodes"),
+    launches.map((name) => h("option", { value: name }, name)),
+  );
+  whatInput.value = launches.includes(chosen) ? chosen : "";
+  paramsOption.hidden = whatInput.value !== "";
 }
 
 /** Whether a run on show is going (a new one cannot start meanwhile). */
@@ -64,7 +95,15 @@ export function runGoing() {
 function runBody() {
   const target = app.target;
   const body = target.exercise ? { exercise: target.exercise.id } : { robot: target.robot, world: target.world };
-  body.nodes = nodes();
+  const workspace = workspaceName();
+  if (workspace) body.workspace = workspace; // its data files go into every node's folder
+  if (whatInput.value) body.launch = { file: whatInput.value };
+  else {
+    const { params, problem } = parseParams(paramsInput.value);
+    if (problem) throw new ParamsProblem(problem);
+    body.nodes = nodes();
+    if (Object.keys(params).length) for (const node of body.nodes) node.params = params;
+  }
   body.clock = clockInput.value;
   body.duration = Number(durationInput.value);
   if (seedInput.value !== "") body.seed = Number(seedInput.value);
@@ -73,7 +112,8 @@ function runBody() {
 }
 
 async function post(body) {
-  flushAll(); // the run gets the code in the request; the workspace keeps it too
+  // The server reads launch files and data files from the workspace: every edit is saved first.
+  await flushAll();
   const run = await api("/api/runs", { method: "POST", body });
   if (body.teleop) app.teleopRuns.add(run.id);
   showRun(run);
@@ -95,6 +135,10 @@ export async function start() {
   try {
     await post(runBody());
   } catch (error) {
+    if (error instanceof ParamsProblem) {
+      paramsInput.setCustomValidity(error.message);
+      paramsInput.reportValidity();
+    }
     say(error.message); // the server's sentence, verbatim
   } finally {
     starting = false;
@@ -123,6 +167,9 @@ export async function startOnRobot(name) {
     controls();
   }
 }
+
+/** A line of the Params field that cannot be read; said before anything is sent. */
+class ParamsProblem extends Error {}
 
 /** No run on show (another exercise was chosen); a live run goes on, unwatched. */
 function forget() {

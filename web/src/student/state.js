@@ -16,6 +16,8 @@
 //   run-graph  {run, graph}        the node/topic graph of the run on show (its built-in nodes)
 //   drive      {}                  a run to drive with the arrow keys started: show the pad
 //   watch-ended {}                 the run opened by its id is left for the student's own code
+//   files      {names}             the workspace's files changed (added, deleted, loaded)
+//   file-shown {filename}          the editor shows this file
 
 export const app = {
   me: null,
@@ -86,3 +88,6 @@ export function runHasTeleop(run) {
 /** A node's file name from its node name, and back. */
 export const fileOf = (node) => `${node}.py`;
 export const nodeOf = (filename) => filename.replace(/\.py$/, "");
+/** A node of a run started from the page: a .py file at the top of the workspace. */
+export const isNodeFile = (filename) => /^[^/]+\.py$/.test(filename);
+export const isLaunchFile = (filename) => /\.(launch|xml)$/i.test(filename);
