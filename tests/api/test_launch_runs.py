@@ -74,7 +74,9 @@ def test_a_launch_file_starts_its_nodes_with_their_parameters(lab):
     assert "rate 10" in logs["talker"], logs["talker"]
     assert any(line.startswith("heard hello") for line in logs["listener"]), logs["listener"]
     graph = student.get(f"/api/runs/{run['id']}/graph").json()
-    assert {"talker", "listener"} <= {node["name"] for node in graph["nodes"]}
+    assert {"talker", "listener"} <= set(graph["nodes"])
+    chatter = next(topic for topic in graph["topics"] if topic["name"].endswith("chatter"))
+    assert (chatter["publishers"], chatter["subscribers"]) == (["talker"], ["listener"])
 
 
 def test_an_exercise_launch_uses_the_exercise_workspace_and_its_starter_files(lab):

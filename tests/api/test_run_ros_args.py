@@ -77,3 +77,43 @@ def test_a_node_reads_its_private_and_global_parameters(lab):
     assert "missing default" in logs, logs
     gains = next(line for line in logs if line.startswith("gains"))
     assert "'kp': 2.0" in gains and "'ki': [0, 1]" in gains, gains
+
+
+SPEAKER = """\
+import rospy
+from std_msgs.msg import String
+
+rospy.init_node("speaker")
+print("rate", rospy.get_param("~rate"))
+pub = rospy.Publisher("chatter", String, queue_size=1)
+rate = rospy.Rate(5)
+while not rospy.is_shutdown():
+    pub.publish(String(data="hi"))
+    rate.sleep()
+"""
+
+
+def test_remaps_args_and_namespace_reach_the_node_as_rosrun_gives_them(lab):
+    student = lab.student("rosrunner")
+    body = {
+        "robot": "crowbot",
+        "world": "wall_approach",
+        "duration": 1.0,
+        "nodes": [
+            {
+                "name": "speaker",
+                "code": SPEAKER,
+                "remaps": {"chatter": "speech"},
+                "args": ["_rate:=4"],
+                "namespace": "robot1",
+            }
+        ],
+    }
+    started = student.post("/api/runs", json=body)
+    assert started.status_code == 201, started.text
+    run = wait_for_end(student, started.json()["id"])
+    assert run["state"] == "finished", run["reason"]
+    logs = student.get(f"/api/runs/{run['id']}/logs").json()["nodes"]["speaker"]
+    assert "rate 4" in logs, logs
+    topics = {t["name"] for t in student.get(f"/api/runs/{run['id']}/graph").json()["topics"]}
+    assert "robot1/speech" in topics and not any(t.endswith("chatter") for t in topics), topics
