@@ -29,8 +29,6 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-import yaml
-
 from sandbox.names import canonicalize, make_global_ns, ns_join
 from server.runs.launch_xml import (
     MAX_LAUNCH_BYTES,
@@ -38,7 +36,7 @@ from server.runs.launch_xml import (
     SubstitutionError,
     Substitutions,
     XmlError,
-    load_yaml,
+    convert_value,
     parse_xml,
 )
 from server.runs.spec import NodeSpec, RunSpecError
@@ -51,7 +49,6 @@ ROBOT_PACKAGES = re.compile(
     r"slam_gmapping|hector_\w+|cartographer\w*|xacro|urdf\w*|rosbag|topic_tools|tf|tf2_ros|"
     r"teleop_twist_keyboard|husky_\w+|jackal_\w+|pr2_\w+|kobuki\w*|turtlebot(_\w+)?)$"
 )
-_PARAM_TYPES = ("auto", "str", "string", "int", "double", "bool", "boolean", "yaml")
 
 
 class LaunchFileError(RunSpecError):
@@ -376,46 +373,6 @@ def _with_name(spec: NodeSpec, name: str) -> NodeSpec:
     from dataclasses import replace
 
     return replace(spec, name=name)
-
-
-def convert_value(value: str, kind: str) -> Any:
-    """A <param> value as roslaunch types it (loader.convert_value): `auto` tries int, then
-    float (a '.' in it), then true/false, else a string; ValueError with a sentence."""
-    kind = kind.lower().strip()
-    if kind not in _PARAM_TYPES:
-        raise ValueError(f"unknown param type '{kind}'; use one of {', '.join(_PARAM_TYPES)}")
-    if kind == "auto":
-        try:
-            if "." in value:
-                return float(value)
-            if "_" not in value:  # roslaunch keeps 1_000 a string (Python would read 1000)
-                return int(value)
-        except ValueError:
-            pass
-        if value.lower() in ("true", "false"):
-            return value.lower() == "true"
-        return value
-    if kind in ("str", "string"):
-        return value
-    if kind == "int":
-        try:
-            return int(value)
-        except ValueError:
-            raise ValueError(f"'{value}' is not an int") from None
-    if kind == "double":
-        try:
-            return float(value)
-        except ValueError:
-            raise ValueError(f"'{value}' is not a double") from None
-    if kind in ("bool", "boolean"):
-        lowered = value.lower().strip()
-        if lowered in ("true", "1", "false", "0"):
-            return lowered in ("true", "1")
-        raise ValueError(f"'{value}' is not a bool (true, false, 1 or 0)")
-    try:
-        return load_yaml(value)
-    except yaml.YAMLError as error:
-        raise ValueError(f"the value is not valid YAML: {error}") from None
 
 
 __all__ = ["LaunchFileError", "LaunchPlan", "convert_value", "load_launch"]

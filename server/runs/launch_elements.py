@@ -7,20 +7,25 @@ from __future__ import annotations
 import posixpath
 import shlex
 from collections.abc import Callable
-from typing import Any
 
 import yaml
 
-from sandbox.names import canonicalize, is_legal_name, is_private, make_global_ns, ns_join
+from sandbox.names import (
+    canonicalize,
+    is_legal_base_name,
+    is_legal_name,
+    is_private,
+    make_global_ns,
+    ns_join,
+)
 from server.runs.launch import (
     ROBOT_PACKAGES,
     LaunchFileError,
     _NodeDraft,
     _Reader,
     _Scope,
-    convert_value,
 )
-from server.runs.launch_xml import Element, load_yaml
+from server.runs.launch_xml import Element, convert_value, load_yaml
 from server.runs.spec import NodeSpec
 
 Handler = Callable[[_Reader, Element, _Scope, int], None]
@@ -293,15 +298,19 @@ def _node(reader: _Reader, element: Element, scope: _Scope, depth: int) -> None:
     _check_namespace(reader, element, scope, ns)
     inner = scope.child(ns)
     full = inner.ns + name
-    for flag in ("respawn", "required"):
-        value = reader.attr(element, scope, flag)
-        if value is not None and reader.boolean(value, flag, element, scope) and flag == "respawn":
-            reader.notes.append(
-                f"{scope.filename}, line {element.line}: node '{full}' has respawn=\"true\"; "
-                "a node that ends is not restarted in a run"
-            )
+    respawn, required = (reader.attr(element, scope, key) for key in ("respawn", "required"))
+    if required is not None:
+        reader.boolean(required, "required", element, scope)  # checked; the run ends anyway
+    if respawn is not None and reader.boolean(respawn, "respawn", element, scope):
+        reader.notes.append(
+            f"{scope.filename}, line {element.line}: node '{full}' has respawn=\"true\"; "
+            "a node that ends is not restarted in a run"
+        )
+    # The scope's ~params first, then the node's own children in order (roslaunch's order).
+    for key, value in inner.private_params.items():
+        reader.set_param(full + "/" + key, value)
     node_scope = inner.child(None)
-    own_params: dict[str, Any] = {}
+    node_scope.private_params = {}
     for child in element.children:
         if not reader._enabled(child, scope):
             continue
@@ -319,10 +328,9 @@ def _node(reader: _Reader, element: Element, scope: _Scope, depth: int) -> None:
                 child,
                 f"<{child.tag}> cannot be inside <node>; it holds <param>, <rosparam>, <remap>",
             )
-    for key, value in {**inner.private_params, **node_scope.private_params}.items():
-        own_params[key] = value
-    for key, value in own_params.items():
-        reader.set_param(full + "/" + key, value)
+        for key, value in node_scope.private_params.items():  # a <rosparam param="~x">
+            reader.set_param(full + "/" + key, value)
+        node_scope.private_params = {}
     path = _node_file(reader, element, scope, pkg, node_type)
     code = reader.text_of(path, scope.filename, element.line, "node file")
     args = reader.attr(element, scope, "args") or ""
@@ -339,12 +347,6 @@ def _node(reader: _Reader, element: Element, scope: _Scope, depth: int) -> None:
         namespace=canonicalize(inner.ns) or "/",
     )
     reader.nodes.append(_NodeDraft(name, inner.ns, spec, (scope.filename, element.line)))
-
-
-def is_legal_base_name(name: str) -> bool:
-    from sandbox.names import is_legal_base_name as legal
-
-    return legal(name)
 
 
 def _node_file(reader: _Reader, element: Element, scope: _Scope, pkg: str, node_type: str) -> str:

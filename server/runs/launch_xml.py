@@ -29,6 +29,7 @@ import yaml
 
 MAX_LAUNCH_BYTES = 256 * 1024  # [bytes] a launch file larger than this is not hand-written
 _SUBSTITUTION = re.compile(r"\$\(([^()]*)\)")
+_PARAM_TYPES = ("auto", "str", "string", "int", "double", "bool", "boolean", "yaml")
 _COMMANDS = ("find", "env", "optenv", "dirname", "anon", "arg", "eval")
 
 
@@ -232,3 +233,43 @@ RosparamLoader.add_implicit_resolver("!radians", re.compile(r"^rad\([^\)]*\)$"),
 def load_yaml(text: str) -> Any:
     """YAML as rosparam reads it; yaml.YAMLError on bad input."""
     return yaml.load(text, Loader=RosparamLoader)  # a SafeLoader subclass: no Python objects
+
+
+def convert_value(value: str, kind: str) -> Any:
+    """A <param> value as roslaunch types it (loader.convert_value): `auto` tries int, then
+    float (a '.' in it), then true/false, else a string; ValueError with a sentence."""
+    kind = kind.lower().strip()
+    if kind not in _PARAM_TYPES:
+        raise ValueError(f"unknown param type '{kind}'; use one of {', '.join(_PARAM_TYPES)}")
+    if kind == "auto":
+        try:
+            if "." in value:
+                return float(value)
+            if "_" not in value:  # roslaunch keeps 1_000 a string (Python would read 1000)
+                return int(value)
+        except ValueError:
+            pass
+        if value.lower() in ("true", "false"):
+            return value.lower() == "true"
+        return value
+    if kind in ("str", "string"):
+        return value
+    if kind == "int":
+        try:
+            return int(value)
+        except ValueError:
+            raise ValueError(f"'{value}' is not an int") from None
+    if kind == "double":
+        try:
+            return float(value)
+        except ValueError:
+            raise ValueError(f"'{value}' is not a double") from None
+    if kind in ("bool", "boolean"):
+        lowered = value.lower().strip()
+        if lowered in ("true", "1", "false", "0"):
+            return lowered in ("true", "1")
+        raise ValueError(f"'{value}' is not a bool (true, false, 1 or 0)")
+    try:
+        return load_yaml(value)
+    except yaml.YAMLError as error:
+        raise ValueError(f"the value is not valid YAML: {error}") from None

@@ -407,3 +407,24 @@ def test_rosparam_angles_as_rosparam_reads_them() -> None:
     assert "invalid angle" in str(error) and error.line == 2
     error = failure("<rosparam>a: !!python/object:os.system x</rosparam>\n")
     assert "not valid YAML" in str(error)
+
+
+def test_a_nodes_own_param_wins_over_the_scopes_private_one() -> None:
+    plan = launch(
+        """
+        <param name="~speed" value="1"/>
+        <param name="~mode" value="scope"/>
+        <node pkg="d" type="talker.py" name="talker">
+          <param name="speed" value="2"/>
+        </node>
+        <node pkg="d" type="listener.py" name="listener" required="true"/>
+        """
+    )
+    assert plan.params == {
+        "talker/speed": 2,
+        "talker/mode": "scope",
+        "listener/speed": 1,
+        "listener/mode": "scope",
+    }
+    error = failure('<node pkg="d" type="talker.py" name="t" required="yes"/>\n')
+    assert "'required' must be true, false" in str(error)
