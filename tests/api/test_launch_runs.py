@@ -99,7 +99,11 @@ def test_an_exercise_launch_uses_the_exercise_workspace_and_its_starter_files(la
         ({}, "two.launch", "no launch file 'two.launch' in your workspace"),
         ({"a.launch": "<launch/>"}, "talker.py", "not a launch file"),
         ({"a.launch": "<launch/>"}, "../a.launch", "'..'"),
-        ({"bad.launch": "<launch>\n  <node pkg='x'\n</launch>\n"}, "bad.launch", "bad.launch"),
+        (
+            {"bad.launch": "<launch>\n  <node pkg='x'\n</launch>\n"},
+            "bad.launch",
+            "bad.launch, line 3: this is not well-formed XML",
+        ),
         (
             {"n.launch": '<launch>\n\n  <node pkg="p" type="ghost.py" name="g"/>\n</launch>'},
             "n.launch",
@@ -170,12 +174,12 @@ ATTACKS = {
         '<!ENTITY b "&a;&a;&a;&a;&a;&a;&a;&a;&a;&a;"><!ENTITY c "&b;&b;&b;&b;&b;&b;&b;&b;&b;">'
         '<!ENTITY d "&c;&c;&c;&c;&c;&c;&c;&c;&c;&c;">]>\n<launch><arg name="x" default="&d;"/>'
         "</launch>\n",
-        "attack.launch",
+        "line 2",
     ),
     "external_entity": (
         '<?xml version="1.0"?>\n<!DOCTYPE l [<!ENTITY x SYSTEM "file:///etc/passwd">]>\n'
         '<launch><param name="p" value="&x;"/></launch>\n',
-        "attack.launch",
+        "line 2",
     ),
 }
 
