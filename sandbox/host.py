@@ -27,7 +27,7 @@ import warnings
 from contextlib import ExitStack
 from typing import ClassVar, Protocol
 
-from sandbox import runtime
+from sandbox import ros_imports, runtime
 from sandbox.artifacts import collect_artifacts, write_workspace_files
 from sandbox.limits import DEFAULT_LIMITS, Limits
 from sandbox.protocol import Api, Clock, Exited, Load, NodeError, Outcome
@@ -50,6 +50,7 @@ def install_ros_compat() -> None:
     """Make `import rospy` and `from std_msgs.msg import ...` find the shim (idempotent)."""
     if ROS_COMPAT_DIR not in sys.path:
         sys.path.insert(0, ROS_COMPAT_DIR)
+    ros_imports.install()  # ROS 1 modules we lack fail with a sentence, not "No module named"
 
 
 def choose_api(tree: ast.Module, requested: Api) -> Api:

@@ -9,18 +9,24 @@ A message class declares only its ROS type name and its ``.msg`` definition text
 The metaclass parses the definition (``_spec.py``), derives ``__slots__``, constants, md5sum and
 full text from it, and attaches a generated ``__init__``, serializer and deserializer
 (``_codegen.py``). Nothing about a type's wire format is written anywhere else.
+
+The ROS types RoboDojo provides are not written as classes: their definitions are a table
+(``_definitions.py``) and ``get_message_class`` builds a class the first time it is asked for,
+so a node pays only for the types it uses (building all ~140 takes tens of milliseconds).
 """
 
 from __future__ import annotations
 
 import keyword
 import textwrap
-import types
-from collections.abc import Mapping
+import threading
+from collections.abc import Iterator, Mapping
 from typing import Any, ClassVar, Self
 
+from ._catalog import unknown_type_sentence
 from ._check import explain_failure
 from ._codegen import ShortBuffer, build_deserializer, build_init, build_serializer
+from ._definitions import MESSAGES
 from ._spec import (
     compute_full_text,
     compute_md5,
@@ -29,8 +35,9 @@ from ._spec import (
 )
 
 _REGISTRY: dict[str, type[Message]] = {}
-# Read-only view of every registered type, keyed by "pkg/Name".
-MESSAGE_TYPES: Mapping[str, type[Message]] = types.MappingProxyType(_REGISTRY)
+# Building a class runs the metaclass, which registers it; a node's callback threads may ask for
+# the same type at once. Re-entrant: building Odometry builds its nested types first.
+_BUILD_LOCK = threading.RLock()
 
 
 class SerializationError(ValueError, TypeError):
@@ -52,25 +59,65 @@ class UnknownMessageTypeError(KeyError):
         return str(self.args[0])
 
 
-def _lookup_registered(msg_type: str) -> type[Message]:
-    try:
-        return _REGISTRY[msg_type]
-    except KeyError:
-        raise ValueError(
-            f"nested type {msg_type} is not defined yet; define (or import) it before the "
-            "message that uses it"
-        ) from None
+def _lookup_nested(msg_type: str) -> type[Message]:
+    cls = _REGISTRY.get(msg_type)
+    if cls is not None:
+        return cls
+    if msg_type in MESSAGES:
+        return _build(msg_type)
+    raise ValueError(
+        f"nested type {msg_type} is not defined yet; define (or import) it before the "
+        "message that uses it"
+    )
+
+
+def _build(msg_type: str) -> type[Message]:
+    """Create (and so register) the class of a type in the definition table."""
+    with _BUILD_LOCK:
+        cls = _REGISTRY.get(msg_type)
+        if cls is None:
+            package, name = msg_type.split("/")
+            namespace = {
+                "__module__": f"sandbox.msgs.{package}",  # where pickle and repr find it
+                "__qualname__": name,
+                "_type": msg_type,
+                "_definition": MESSAGES[msg_type],
+            }
+            cls = _MessageMeta(name, (Message,), namespace, from_table=True)
+        return cls
 
 
 def get_message_class(msg_type: str) -> type[Message]:
-    """The class registered for ``"pkg/Name"``, e.g. ``get_message_class("std_msgs/Int32")``."""
-    try:
-        return _REGISTRY[msg_type]
-    except KeyError:
-        known = ", ".join(sorted(_REGISTRY))
-        raise UnknownMessageTypeError(
-            f"unknown message type {msg_type!r}; known types are: {known}"
-        ) from None
+    """The class of ``"pkg/Name"``, e.g. ``get_message_class("std_msgs/Int32")``.
+
+    Built on first use for the ROS types RoboDojo provides; raises UnknownMessageTypeError
+    (a KeyError) with a sentence naming close matches for anything else.
+    """
+    cls = _REGISTRY.get(msg_type)
+    if cls is not None:
+        return cls
+    if msg_type in MESSAGES:
+        return _build(msg_type)
+    raise UnknownMessageTypeError(unknown_type_sentence(msg_type))
+
+
+class _MessageTypes(Mapping[str, "type[Message]"]):
+    """Read-only view of every type, keyed by "pkg/Name"; a class is built when looked up."""
+
+    def __getitem__(self, msg_type: str) -> type[Message]:
+        return get_message_class(msg_type)
+
+    def __contains__(self, msg_type: object) -> bool:
+        return msg_type in MESSAGES or msg_type in _REGISTRY
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(sorted(MESSAGES.keys() | _REGISTRY.keys()))
+
+    def __len__(self) -> int:
+        return len(MESSAGES.keys() | _REGISTRY.keys())
+
+
+MESSAGE_TYPES: Mapping[str, type[Message]] = _MessageTypes()
 
 
 class _MessageMeta(type):
@@ -82,6 +129,7 @@ class _MessageMeta(type):
         bases: tuple[type, ...],
         namespace: dict[str, Any],
         register: bool = True,
+        from_table: bool = False,
     ) -> _MessageMeta:
         if "_definition" not in namespace:  # the abstract Message base itself
             return super().__new__(mcls, name, bases, namespace)
@@ -90,8 +138,13 @@ class _MessageMeta(type):
             raise TypeError(f"message class {name} needs _type = 'pkg/Name', got {msg_type!r}")
         if register and msg_type in _REGISTRY:
             raise TypeError(f"{msg_type} is already defined by {_REGISTRY[msg_type].__module__}")
+        if register and msg_type in MESSAGES and not from_table:
+            raise TypeError(
+                f"{msg_type} is a ROS type RoboDojo provides: use get_message_class"
+                f"({msg_type!r}) instead of defining it again"
+            )
         definition = textwrap.dedent(namespace["_definition"]).strip("\n").rstrip()
-        constants, fields = parse_definition(msg_type, definition, _lookup_registered)
+        constants, fields = parse_definition(msg_type, definition, _lookup_nested)
         for field in fields:
             if keyword.iskeyword(field.name):
                 raise ValueError(f"{msg_type}: field name {field.name!r} is a Python keyword")

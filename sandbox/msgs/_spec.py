@@ -12,7 +12,7 @@ from __future__ import annotations
 import hashlib
 import re
 import struct
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -163,8 +163,8 @@ def parse_definition(
     return constants, fields
 
 
-def compute_md5(constants: list[ConstantSpec], fields: list[FieldSpec]) -> str:
-    """md5sum as genmsg computes it: constants first, nested types replaced by their md5."""
+def compute_md5_text(constants: Sequence[ConstantSpec], fields: Sequence[FieldSpec]) -> str:
+    """The text genmsg hashes: constants first, nested types replaced by their md5."""
     lines = [f"{c.type} {c.name}={c.value_text}" for c in constants]
     for field in fields:
         if field.message_class is None:
@@ -172,7 +172,20 @@ def compute_md5(constants: list[ConstantSpec], fields: list[FieldSpec]) -> str:
         else:
             # An array of messages hashes as the bare nested md5, without "[]".
             lines.append(f"{field.message_class._md5sum} {field.name}")
-    return hashlib.md5("\n".join(lines).strip().encode()).hexdigest()
+    return "\n".join(lines).strip()
+
+
+def compute_md5(constants: Sequence[ConstantSpec], fields: Sequence[FieldSpec]) -> str:
+    """md5sum of a message as genmsg computes it (``gentools.compute_md5``)."""
+    return hashlib.md5(compute_md5_text(constants, fields).encode()).hexdigest()
+
+
+def compute_service_md5(request: Any, response: Any) -> str:
+    """md5sum of a service: one hash over the request's then the response's md5 text."""
+    digest = hashlib.md5()
+    for cls in (request, response):
+        digest.update(compute_md5_text(cls._constant_specs, cls._field_specs).encode())
+    return digest.hexdigest()
 
 
 def dependency_order(fields: list[FieldSpec]) -> list[Any]:

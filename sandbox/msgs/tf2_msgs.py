@@ -1,15 +1,8 @@
-"""tf2_msgs: the transform tree message published on ``/tf`` (definition as in ros/geometry2)."""
+"""tf2_msgs: the transform tree message on /tf, the LookupTransform action (ros/geometry2).
 
-from __future__ import annotations
-
-from . import geometry_msgs as _geometry_msgs  # noqa: F401  # registers TransformStamped
-from ._core import Message
-
-
-class TFMessage(Message):
-    """A batch of transforms, each the pose of a child frame in its parent frame."""
-
-    _type = "tf2_msgs/TFMessage"
-    _definition = """
-geometry_msgs/TransformStamped[] transforms
+Each class is built on first use from the definitions in ``_definitions.py``.
 """
+
+from ._lazy import install
+
+install(globals(), "tf2_msgs", ("msg", "srv"))

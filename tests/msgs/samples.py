@@ -1,11 +1,15 @@
-"""One message with non-default values for every registered type, shared by the tests.
+"""One message with non-default values for every type, shared by the tests.
 
-float32 fields use values exact in single precision so round trips compare equal.
+The types RoboDojo's own code uses have a sample written by hand (SAMPLES); every other type gets
+one from ``filled``, which gives each field a value that differs from its default and from its
+neighbours'. float32 fields use values exact in single precision so round trips compare equal.
 """
 
 from collections.abc import Callable
+from typing import Any
 
 from sandbox.msgs import (
+    MESSAGE_TYPES,
     Duration,
     Message,
     Time,
@@ -15,6 +19,7 @@ from sandbox.msgs import (
     std_msgs,
     tf2_msgs,
 )
+from sandbox.msgs._spec import INT_RANGES, FieldSpec
 
 
 def header(seq: int = 7) -> std_msgs.Header:
@@ -127,3 +132,45 @@ SAMPLES: dict[str, Callable[[], Message]] = {
         header(), [geometry_msgs.PoseStamped(header(i), _pose(float(i))) for i in range(3)]
     ),
 }
+
+
+def _value(field: FieldSpec, seed: int) -> Any:
+    """A non-default value of one element of ``field``; ``seed`` makes neighbours differ."""
+    kind = field.kind
+    if kind == "message":
+        return filled(field.message_class, seed)
+    if kind == "bool":
+        return True
+    if kind == "int":
+        low, high = INT_RANGES[field.code]
+        return low + seed % 7 if low < 0 else min(high, 200 + seed % 50)  # extremes of the range
+    if kind == "float":
+        return -1.25 - 0.5 * (seed % 64)  # exact in float32
+    if kind == "string":
+        return f"f{seed} ✓"  # non-ASCII: UTF-8 length differs from the character count
+    if kind == "time":
+        return Time(1_700_000_000 + seed, 999_999_999 - seed)
+    return Duration(-3 - seed, 250_000_000)
+
+
+def filled(cls: type[Message], seed: int = 1) -> Message:
+    """An instance of ``cls`` whose every field (nested ones too) differs from the default;
+    variable-length arrays hold two elements (uint8 arrays: bytes, as genpy decodes them)."""
+    values = {}
+    for index, field in enumerate(cls._field_specs):  # type: ignore[attr-defined]
+        field_seed = seed * 31 + index
+        if not field.is_array:
+            values[field.name] = _value(field, field_seed)
+            continue
+        count = 2 if field.array_len is None else field.array_len
+        items = [_value(field, field_seed + i) for i in range(count)]
+        if field.kind == "int" and field.code == "B":
+            items = bytes(items)
+        values[field.name] = items
+    return cls(**values)
+
+
+def sample(msg_type: str) -> Message:
+    """The hand-written sample of ``msg_type`` if there is one, else a filled instance."""
+    make = SAMPLES.get(msg_type)
+    return make() if make is not None else filled(MESSAGE_TYPES[msg_type])

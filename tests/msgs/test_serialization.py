@@ -20,16 +20,16 @@ from sandbox.msgs import (
     std_msgs,
 )
 
-from .samples import SAMPLES, header
+from .samples import SAMPLES, header, sample
 
 
-def test_every_registered_type_has_a_sample() -> None:
-    assert sorted(SAMPLES) == sorted(MESSAGE_TYPES)
+def test_every_hand_written_sample_is_of_a_known_type() -> None:
+    assert set(SAMPLES) <= set(MESSAGE_TYPES)
 
 
-@pytest.mark.parametrize("msg_type", sorted(SAMPLES))
+@pytest.mark.parametrize("msg_type", sorted(MESSAGE_TYPES))
 def test_sample_round_trips(msg_type: str) -> None:
-    message = SAMPLES[msg_type]()
+    message = sample(msg_type)
     cls = MESSAGE_TYPES[msg_type]
     assert type(message) is cls
     data = message.serialize()
@@ -197,9 +197,9 @@ def test_truncated_int32_says_how_many_bytes() -> None:
     assert str(caught.value).startswith("std_msgs/Int32: buffer too short (got 2 bytes, need 4)")
 
 
-@pytest.mark.parametrize("msg_type", sorted(SAMPLES))
+@pytest.mark.parametrize("msg_type", sorted(MESSAGE_TYPES))
 def test_every_truncation_is_rejected_with_the_type_name(msg_type: str) -> None:
-    data = SAMPLES[msg_type]().serialize()
+    data = sample(msg_type).serialize()
     cls = MESSAGE_TYPES[msg_type]
     for length in range(len(data)):
         with pytest.raises(ValueError, match=f"^{msg_type}: buffer too short"):

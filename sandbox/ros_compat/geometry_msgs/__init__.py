@@ -1,1 +1,1 @@
-"""`geometry_msgs` for student code: `from geometry_msgs.msg import ...` (see sandbox.msgs)."""
+"""The ROS 1 package `geometry_msgs` for student code: `geometry_msgs.msg`."""

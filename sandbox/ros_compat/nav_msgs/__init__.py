@@ -1,1 +1,1 @@
-"""`nav_msgs` for student code: `from nav_msgs.msg import ...` (see sandbox.msgs)."""
+"""The ROS 1 package `nav_msgs` for student code: `nav_msgs.msg` and `nav_msgs.srv`."""

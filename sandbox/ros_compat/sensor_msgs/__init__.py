@@ -1,1 +1,1 @@
-"""`sensor_msgs` for student code: `from sensor_msgs.msg import ...` (see sandbox.msgs)."""
+"""The ROS 1 package `sensor_msgs` for student code: `sensor_msgs.msg` and `sensor_msgs.srv`."""

@@ -1,1 +1,1 @@
-"""`std_msgs` for student code: `from std_msgs.msg import ...` (see sandbox.msgs)."""
+"""The ROS 1 package `std_msgs` for student code: `std_msgs.msg`."""

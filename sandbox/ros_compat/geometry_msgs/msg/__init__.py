@@ -1,13 +1,5 @@
-"""The geometry_msgs message classes (defined once, in sandbox.msgs.geometry_msgs)."""
+"""`geometry_msgs.msg`: the message classes of sandbox.msgs.geometry_msgs, built on first use."""
 
-from sandbox.msgs import Message as _Message
-from sandbox.msgs import geometry_msgs as _definitions
+from sandbox.msgs._lazy import install
 
-__all__ = sorted(
-    name
-    for name, value in vars(_definitions).items()
-    if isinstance(value, type)
-    and issubclass(value, _Message)
-    and getattr(value, "_type", "").startswith("geometry_msgs/")
-)
-globals().update({name: getattr(_definitions, name) for name in __all__})
+install(globals(), "geometry_msgs", ("msg",))

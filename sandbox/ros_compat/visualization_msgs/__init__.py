@@ -1,0 +1,1 @@
+"""The ROS 1 package `visualization_msgs` for student code: `visualization_msgs.msg`."""
