@@ -136,13 +136,13 @@ class _MessageMeta(type):
         msg_type = namespace.get("_type")
         if not isinstance(msg_type, str) or msg_type.count("/") != 1:
             raise TypeError(f"message class {name} needs _type = 'pkg/Name', got {msg_type!r}")
-        if register and msg_type in _REGISTRY:
-            raise TypeError(f"{msg_type} is already defined by {_REGISTRY[msg_type].__module__}")
         if register and msg_type in MESSAGES and not from_table:
             raise TypeError(
                 f"{msg_type} is a ROS type RoboDojo provides: use get_message_class"
                 f"({msg_type!r}) instead of defining it again"
             )
+        if register and msg_type in _REGISTRY:
+            raise TypeError(f"{msg_type} is already defined by {_REGISTRY[msg_type].__module__}")
         definition = textwrap.dedent(namespace["_definition"]).strip("\n").rstrip()
         constants, fields = parse_definition(msg_type, definition, _lookup_nested)
         for field in fields:

@@ -63,7 +63,10 @@ def test_registry_cannot_be_modified_from_outside() -> None:
         MESSAGE_TYPES["x/Y"] = std_msgs.Int32  # type: ignore[index]
 
 
-def test_a_provided_type_cannot_be_defined_again() -> None:
+@pytest.mark.parametrize("built_first", [False, True])
+def test_a_provided_type_cannot_be_defined_again(built_first: bool) -> None:
+    if built_first:
+        get_message_class("std_msgs/Int64")
     with pytest.raises(TypeError, match="a ROS type RoboDojo provides: use get_message_class"):
 
         class Int64(Message):

@@ -3,6 +3,7 @@
 import pytest
 
 from sandbox.msgs import MESSAGE_TYPES, Message, geometry_msgs, nav_msgs, sensor_msgs, std_msgs
+from sandbox.msgs._core import _REGISTRY
 from sandbox.msgs._spec import parse_definition
 
 # Real ROS1 md5sums, from a ROS Noetic installation (rosmsg md5).
@@ -157,8 +158,16 @@ def test_unknown_nested_type_says_to_define_it_first() -> None:
 
 
 def test_duplicate_type_is_rejected() -> None:
-    with pytest.raises(TypeError, match="already defined"):
+    class Once(Message):
+        _type = "test_msgs/Once"
+        _definition = "int32 data"
 
-        class Int32Again(Message):
-            _type = "std_msgs/Int32"
-            _definition = "int32 data"
+    try:
+        with pytest.raises(TypeError, match=r"test_msgs/Once is already defined by tests\.msgs"):
+
+            class Twice(Message):
+                _type = "test_msgs/Once"
+                _definition = "int32 data"
+
+    finally:
+        _REGISTRY.pop("test_msgs/Once")
