@@ -11,7 +11,7 @@ parent raises the link's `ProtocolError`.
 
 What run_node sets up for itself (and undoes on return, so tests can run many nodes in one
 process): sandbox/ros_compat on sys.path, MPLBACKEND=Agg, the `time` patches of a lockstep
-clock, the working directory, sys.argv = [filename], `__main__`, warnings in their default
+clock, the working directory, sys.argv = [filename, *argv], `__main__`, warnings in their default
 (print-once) form, and a rospy-style root logging handler.
 """
 
@@ -132,7 +132,7 @@ def _environment(stack: ExitStack, node: NodeRuntime, load: Load, workdir: str) 
     os.chdir(workdir)
     stack.callback(os.chdir, previous_cwd)
     saved_argv, saved_main = sys.argv, sys.modules.get("__main__")
-    sys.argv = [load.filename]
+    sys.argv = [load.filename, *load.info.argv]  # as rosrun and roslaunch pass them
     stack.callback(setattr, sys, "argv", saved_argv)
     if saved_main is not None:
         stack.callback(sys.modules.__setitem__, "__main__", saved_main)

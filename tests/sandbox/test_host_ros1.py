@@ -346,3 +346,25 @@ def test_a_loop_spinning_on_time_time_ends_in_lockstep(tmp_path: Path) -> None:
     )
     assert exited.outcome is Outcome.FINISHED, exited.error
     assert yields[-1].wake_at_s == pytest.approx(0.2, abs=0.002)
+
+
+def test_rosrun_arguments_reach_sys_argv_and_myargv_drops_remaps(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    _, exited = run(
+        """
+        import sys
+        import rospy
+        rospy.init_node('args')
+        rospy.loginfo("argv %s", sys.argv[1:])
+        rospy.loginfo("myargv %s", rospy.myargv()[1:])
+        rospy.loginfo("resolved %s", rospy.resolve_name('scan'))
+        """,
+        tmp_path,
+        info=crowbot_info(argv=["left", "_speed:=0.2", "scan:=base_scan"]),
+    )
+    assert exited.outcome is Outcome.FINISHED, exited.error
+    out = capsys.readouterr().out
+    assert "argv ['left', '_speed:=0.2', 'scan:=base_scan']" in out
+    assert "myargv ['left']" in out
+    assert "resolved /base_scan" in out
