@@ -34,7 +34,18 @@ FIGURE_PX = (2400, 1200)  # [px] the CrowBot paper's figures: 12 x 6 in at 200 d
 STILL_M = 0.01  # [m] less than this between two poses: the robot stood still
 # Realtime runs wait on the wall clock most of the time; this many share the machine at once.
 REALTIME_RUNS_AT_ONCE = 3
+LOCKSTEP_SHARE = 0.9  # of the periods a lockstep run must show (start-up and end cost one each)
+REALTIME_SHARE = 0.3  # ... a realtime run must show
 FINISHED = ("finished: duration reached", "finished: every node ended")
+
+
+def at_least(outcome: Outcome, rate_hz: float, seconds: float) -> int:
+    """How many periodic messages a run must show at least: all but a few in lockstep; fewer
+    in realtime, where a loaded machine wakes nodes late and they lose periods (as a real
+    robot's computer does): with the test suite of six helpers on two cores (load 12), a
+    20 Hz loop was measured at 8-9 Hz."""
+    share = REALTIME_SHARE if outcome.clock is Clock.REALTIME else LOCKSTEP_SHARE
+    return math.floor(share * rate_hz * seconds)
 
 
 def sensor_distance(x_m: float) -> float:
@@ -65,6 +76,8 @@ def assert_figures(outcome: Outcome, node: str, *names: str) -> None:
 
 
 def node_messages(outcome: Outcome, topic: str, node: str) -> int:
+    """Messages on `topic`, which `node` publishes (the graph lists a node's topics while it
+    lives, so a script that ended is checked by its log instead)."""
     entry = outcome.graph.get(topic)
     assert entry is not None, f"no topic {topic} in the run's graph: {sorted(outcome.graph)}"
     assert node in entry["publishers"], entry
@@ -74,12 +87,12 @@ def node_messages(outcome: Outcome, topic: str, node: str) -> int:
 # ------------------------------------------------------------------------------------ checks
 def check_talker_listener(outcome: Outcome) -> None:
     heard = re.findall(r"/listener\S* I heard hello world (\d+\.?\d*)", outcome.log("listener"))
-    assert len(heard) >= 20, outcome.describe()
+    assert len(heard) >= at_least(outcome, 10, 3.0), outcome.describe()
     # The talker stamps each line with rospy.get_time(): the listener hears them in order.
     stamps = [float(value) for value in heard]
     assert stamps == sorted(stamps) and stamps[-1] - stamps[0] >= 2.0
     chatter = outcome.messages("chatter")
-    assert 25 <= len(chatter) <= 32, len(chatter)  # 10 Hz for 3 s
+    assert at_least(outcome, 10, 3.0) <= len(chatter) <= 31, len(chatter)
     assert chatter[0][1].data.startswith("hello world ")
     entry = outcome.graph["chatter"]
     assert entry["publishers"] == ["talker"] and entry["subscribers"] == ["listener"]
@@ -88,7 +101,7 @@ def check_talker_listener(outcome: Outcome) -> None:
 def check_class_approach(outcome: Outcome) -> None:
     assert sensor_distance(outcome.end.x) == pytest.approx(0.30, abs=0.03)
     assert outcome.metrics["run"]["collisions"] == 0
-    assert node_messages(outcome, "Control", "class_approach") >= 70  # 10 Hz for 8 s
+    assert node_messages(outcome, "Control", "class_approach") >= at_least(outcome, 10, 8.0)
 
 
 def check_busy_approach(outcome: Outcome) -> None:
@@ -121,9 +134,12 @@ def check_timer(outcome: Outcome) -> None:
     assert outcome.travelled_between(0.0, 2.2) == pytest.approx(0.2, abs=0.04)
     assert_still_after(outcome, 2.4)
     ticks = int(assert_log(outcome, "timer_driver", r"stopped after (\d+) ticks").group(1))
-    assert 18 <= ticks <= 21
+    assert at_least(outcome, 10, 2.0) <= ticks <= 20
     period = float(assert_log(outcome, "timer_driver", r"timer period (\d\.\d+) s").group(1))
-    assert period == pytest.approx(0.1, abs=0.02)
+    if outcome.clock is Clock.LOCKSTEP:
+        assert period == pytest.approx(0.1, abs=0.001)
+    else:
+        assert 0.09 <= period <= 0.3
 
 
 def check_services(outcome: Outcome) -> None:
@@ -159,7 +175,8 @@ def check_rosrun_args(outcome: Outcome) -> None:
 def check_remap(outcome: Outcome) -> None:
     assert_log(outcome, "remap_forward", r"publishing on /Control")
     assert outcome.travelled_between(0.0, outcome.end.t) == pytest.approx(0.2, abs=0.04)
-    assert node_messages(outcome, "Control", "remap_forward") >= 35  # 20 Hz for 2 s
+    # Its 20 Hz for 2 s (the graph lists no publisher: the script has ended).
+    assert outcome.graph["Control"]["messages"] >= at_least(outcome, 20, 2.0)
     assert "cmd_vel" not in outcome.recording
 
 
@@ -195,7 +212,8 @@ def check_shutdown_hook(outcome: Outcome) -> None:
 
 def check_wait_for_scan(outcome: Outcome) -> None:
     match = assert_log(outcome, "wait_for_scan", r"first scan after (\d+\.\d+) s with (\d+) beams")
-    assert float(match.group(1)) < 0.2  # the scan comes at 15 Hz: no waiting out the timeout
+    # The scan comes at 15 Hz: the wait ends at the first one, not at the 5 s timeout.
+    assert float(match.group(1)) < (0.1 if outcome.clock is Clock.LOCKSTEP else 1.0)
     first_scan = outcome.messages("scan")[0][1]
     assert int(match.group(2)) == len(first_scan.ranges)
     assert outcome.travelled_between(0.0, outcome.end.t) >= 0.4
@@ -230,7 +248,7 @@ def check_tb3_closest(outcome: Outcome) -> None:
 
 def check_debug_topic(outcome: Outcome) -> None:
     errors = [message.data for _, message in outcome.messages("debug/error")]
-    assert len(errors) >= 40, len(errors)  # 10 Hz for 6 s; a loaded machine loses a few (realtime)
+    assert len(errors) >= at_least(outcome, 10, 6.0), len(errors)
     assert errors[0] == pytest.approx(0.3, abs=0.02) and abs(errors[-1]) < 0.03
     assert outcome.graph["debug/error"]["subscribers"] == []
     assert sensor_distance(outcome.end.x) == pytest.approx(0.30, abs=0.03)
@@ -256,7 +274,7 @@ def check_waypoints(outcome: Outcome) -> None:
     trajectory = outcome.artifact("waypoint_driver", "trajectory.csv")
     assert trajectory.is_file(), outcome.describe()
     rows = list(csv.DictReader(io.StringIO(trajectory.read_text())))
-    assert len(rows) >= 60  # 20 Hz for 4.5 s
+    assert len(rows) >= at_least(outcome, 20, 4.5)
     times = [float(row["t"]) for row in rows]
     assert times == sorted(times) and times[-1] - times[0] >= 4.0
 
@@ -283,7 +301,8 @@ def check_reactive(outcome: Outcome) -> None:
     assert sensor_distance(outcome.end.x) == pytest.approx(0.35, abs=0.02)
     # One command per Distance reading: messages flow robot -> node -> robot at 20 Hz.
     distance = outcome.graph["Distance"]["messages"]
-    assert node_messages(outcome, "Control", "reactive_callback") >= 0.9 * distance
+    share = REALTIME_SHARE if outcome.clock is Clock.REALTIME else LOCKSTEP_SHARE
+    assert node_messages(outcome, "Control", "reactive_callback") >= share * distance
 
 
 # ------------------------------------------------------------------------------------- cases
