@@ -660,9 +660,48 @@ def test_course_script_runs_unchanged(
     case.check(outcome)
 
 
+# Course scripts that cannot run here, each with the sentence it must get instead of a bare
+# error: the file's line, what is missing and what to use.
+REFUSED = (
+    (
+        "add_two_ints_client.py",
+        "ModuleNotFoundError at line 6",
+        r"rospy_tutorials is not available in RoboDojo: .*use std_srvs",
+    ),
+    (
+        "rate_before_init.py",
+        "ROSInitException at line 7",
+        r"rospy\.Rate\(\) needs a node: call rospy\.init_node",
+    ),
+)
+
+
+@pytest.mark.parametrize(
+    ("script", "raised", "sentence"), REFUSED, ids=[script for script, _, _ in REFUSED]
+)
+def test_a_script_that_cannot_run_gets_a_sentence(
+    script: str, raised: str, sentence: str, launcher, tmp_path
+) -> None:
+    outcome = run_scripts(
+        launcher,
+        tmp_path / "run",
+        robot="crowbot",
+        world="wall_approach",
+        nodes=(Node(script),),
+        clock=Clock.LOCKSTEP,
+        duration_s=2.0,
+    )
+    node = script.removesuffix(".py")
+    assert outcome.state == "failed"
+    assert outcome.reason == f"failed: node {node} raised {raised}", outcome.describe()
+    log = outcome.log(node)
+    assert re.search(sentence, log), log
+    assert f'File "{script}", line' in log
+
+
 def test_the_corpus_is_large_enough_and_every_script_is_used() -> None:
     scripts = {path.name for path in SCRIPTS.glob("*.py")}
-    used = {node.file for case in CASES for node in case.nodes}
+    used = {node.file for case in CASES for node in case.nodes} | {s for s, _, _ in REFUSED}
     assert len(scripts) >= 25
     launched = {"launch_driver.py", "range_monitor.py"}  # named by approach.launch
     assert scripts == used | launched, scripts ^ (used | launched)
