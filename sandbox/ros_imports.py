@@ -155,6 +155,11 @@ def sentence_for(fullname: str) -> str | None:
         return f"{fullname} is not available in RoboDojo: {MISSING_SUBMODULES[fullname]}"
     if top in MISSING_MODULES:
         return f"{top} is not available in RoboDojo: {MISSING_MODULES[top]}"
+    if top == "roslib" and rest:
+        return (
+            f"{fullname} is not available in RoboDojo: roslib has load_manifest (which does "
+            "nothing here) and roslib.message (get_message_class, get_service_class) only"
+        )
     ours = _catalog.packages()
     if top in ours and rest:
         kind, _, name = rest.partition(".")

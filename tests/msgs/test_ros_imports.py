@@ -69,6 +69,11 @@ def test_a_missing_module_of_a_package_we_have() -> None:
     assert sentence_for("sensor_msgs.msg.LaserScan") == (
         "sensor_msgs.msg.LaserScan is not a module: write `from sensor_msgs.msg import LaserScan`"
     )
+    assert sentence_for("roslib.packages") == (
+        "roslib.packages is not available in RoboDojo: roslib has load_manifest (which does "
+        "nothing here) and roslib.message (get_message_class, get_service_class) only"
+    )
+    assert sentence_for("roslib") is None  # provided
     assert sentence_for("sensor_msgs.point_cloud2").startswith(
         "sensor_msgs.point_cloud2 is not available in RoboDojo: read sensor_msgs/PointCloud2"
     )
