@@ -214,6 +214,7 @@ def run_launch_file(
     out_dir: Path,
     *,
     launch: str,
+    launch_args: tuple[str, ...] = (),
     robot: str,
     world: str,
     clock: Clock,
@@ -221,7 +222,7 @@ def run_launch_file(
     spawn: str | None = None,
     seed: int = 1,
 ) -> Outcome:
-    """Run a launch file as a student would: `robodojo run --launch FILE`."""
+    """Run a launch file as a student would: `robodojo run --launch FILE [name:=value ...]`."""
     command = [
         sys.executable,
         "-m",
@@ -233,6 +234,7 @@ def run_launch_file(
         world,
         "--launch",
         str(SCRIPTS / launch),
+        *launch_args,
         "--clock",
         clock.value,
         "--duration",

@@ -265,12 +265,25 @@ def check_debug_topic(outcome: Outcome) -> None:
     assert sensor_distance(outcome.end.x) == pytest.approx(0.30, abs=0.03)
 
 
-def check_launch(outcome: Outcome) -> None:
-    driver = next((name for name in outcome.logs if name.endswith("driver")), "driver")
-    assert_log(outcome, driver, r"crowbot_lab_3: speed 0\.10, stop at 0\.30 m, kp 0\.80")
-    assert sensor_distance(outcome.end.x) == pytest.approx(0.30, abs=0.03)
+def check_launch(outcome: Outcome, stop_distance_m: float = 0.30) -> None:
+    assert_log(
+        outcome,
+        "driver",
+        rf"crowbot_lab_3: speed 0\.10, stop at {stop_distance_m:.2f} m, kp 0\.80",
+    )
+    assert sensor_distance(outcome.end.x) == pytest.approx(stop_distance_m, abs=0.03)
+    # <group ns="monitor">: its node's relative topic lands in the namespace; <remap>s bring
+    # both nodes to the robot's Distance.
+    assert_log(outcome, "range_monitor", r"namespace /monitor/, publishing /monitor/too_close")
+    assert outcome.graph["Distance"]["subscribers"] == ["driver", "range_monitor"]
     too_close = [message.data for _, message in outcome.messages("monitor/too_close")]
-    assert too_close and not too_close[0] and too_close[-1], too_close[:3] + too_close[-3:]
+    assert too_close and not too_close[0], too_close[:3]
+    # The monitor's threshold is 40 cm: it turns true once the robot is that close.
+    assert too_close[-1] is (stop_distance_m < 0.40), too_close[-3:]
+
+
+def check_launch_with_args(outcome: Outcome) -> None:
+    check_launch(outcome, stop_distance_m=0.45)
 
 
 def check_waypoints(outcome: Outcome) -> None:
@@ -328,6 +341,7 @@ class Case:
     check: Callable[[Outcome], None]
     nodes: tuple[Node, ...] = ()
     launch: str | None = None
+    launch_args: tuple[str, ...] = ()  # name:=value, as roslaunch takes them
     spawn: str | None = None
     initial_pose: tuple[float, float, float] | None = None  # x [m], y [m], yaw [rad]
     files: tuple[str, ...] = ()  # workspace data files the scripts read
@@ -540,6 +554,16 @@ CASES = (
         launch="approach.launch",
     ),
     Case(
+        "launch_file_args",
+        "crowbot",
+        "wall_approach",
+        6.0,
+        check_launch_with_args,
+        launch="approach.launch",
+        launch_args=("stop_distance:=0.45",),
+        clocks=(Clock.LOCKSTEP,),  # the launch file's realtime run is launch_file's
+    ),
+    Case(
         "waypoints_csv",
         "turtlebot",
         "office",
@@ -603,6 +627,7 @@ def run_case(case: Case, clock: Clock, launcher, out_dir) -> Outcome:
         return run_launch_file(
             out_dir,
             launch=case.launch,
+            launch_args=case.launch_args,
             robot=case.robot,
             world=case.world,
             clock=clock,
