@@ -37,6 +37,7 @@ MAX_ROUNDS_PER_INSTANT = 100
 # earlier through their fds, so this only bounds how stale `progress` can look.
 REALTIME_IDLE_S = 0.05
 GIL_SWITCH_INTERVAL_S = 0.0005  # [s] see run_realtime
+REALTIME_REPLY_ROUNDS = 4  # rounds of collecting replies and waking nodes in one realtime step
 
 
 def run_lockstep(run: Run) -> None:
@@ -101,17 +102,24 @@ class RealtimeDriver:
         run.advance_to(min(now_ns, run.duration_ns))
         if run.time_ns >= run.duration_ns:
             return False
-        for slot in order:
-            if slot.done or slot.process is None:
-                continue
-            if slot.process.state == "running":
-                reply = slot.process.poll_reply(0.0)
-                if reply is not None:
-                    run.handle_reply(slot, reply)
-            if slot.done:
-                continue
-            if slot.process.state == "sleeping" and run.is_due(slot, run.time_ns):
-                run.begin_wake(slot, run.time_ns)
+        # A reply may carry a message another node waits on (a service request, its answer):
+        # go round again while replies come in, so such a node is woken now, not at the next
+        # deadline (a few rounds at most: a busy node replies at once, every time).
+        replied, rounds = True, 0
+        while replied and rounds < REALTIME_REPLY_ROUNDS:
+            replied, rounds = False, rounds + 1
+            for slot in order:
+                if slot.done or slot.process is None:
+                    continue
+                if slot.process.state == "running":
+                    reply = slot.process.poll_reply(0.0)
+                    if reply is not None:
+                        run.handle_reply(slot, reply)
+                        replied = True
+                if slot.done:
+                    continue
+                if slot.process.state == "sleeping" and run.is_due(slot, run.time_ns):
+                    run.begin_wake(slot, run.time_ns)
         # Next: a sleeping node's wake time, the robot's next message, or an idle check; a
         # node still computing is not due (its reply makes its fds readable).
         running = [

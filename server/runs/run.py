@@ -21,6 +21,7 @@ from collections import deque
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import sandbox.services  # noqa: F401  # registers the service envelope types the recorder sees
 from sandbox.launcher import Launcher
 from sandbox.msgs import Time, get_message_class
 from sandbox.msgs.geometry_msgs import Point, Pose, PoseStamped, Quaternion

@@ -45,7 +45,6 @@ from dataclasses import dataclass
 from enum import StrEnum
 
 from sandbox.msgs import (
-    MESSAGE_TYPES,
     DeserializationError,
     Message,
     UnknownMessageTypeError,
@@ -383,11 +382,11 @@ class RosserialSession:
             return f"topic '{name}' was advertised with a buffer of {info.buffer_size} bytes"
         try:
             ours = self._resolve_type(message_type)._md5sum
-        except UnknownMessageTypeError:
+        except UnknownMessageTypeError as error:
+            # The error names close matches; the full list (140 types) would drown them.
             return (
                 f"topic '{name}': RoboDojo has no message type {message_type!r} (the robot's "
-                f"md5sum is {theirs}), so the topic is refused; known types: "
-                + ", ".join(sorted(MESSAGE_TYPES))
+                f"md5sum is {theirs}), so the topic is refused: {error}"
             )
         if ours != theirs:
             return (
