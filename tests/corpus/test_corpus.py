@@ -134,10 +134,6 @@ CASES = (
         4.0,
         check_services,
         nodes=(Node("motor_server.py"), Node("motor_client.py")),
-        needs=(
-            "a fix: a service call between nodes ends the run with an internal error "
-            "(the recorder does not know robodojo_msgs/ServiceCall)",
-        ),
     ),
     Case(
         "params_default",
