@@ -187,7 +187,10 @@ def test_a_huge_body_is_refused_before_it_is_read(lab):
 def test_workspace_file_limits(small_lab):
     student = small_lab.student("writer")
     too_big = student.put("/api/workspaces/crowbot/files/a.py", json={"code": "#" * 2001})
-    assert too_big.status_code == 413 and "limit is 2000" in too_big.json()["detail"]
+    assert (
+        too_big.status_code == 413
+        and "limit for a code file is 2000 bytes" in (too_big.json()["detail"])
+    )
     bad_name = student.put("/api/workspaces/crowbot/files/-x.py", json={"code": ""})
     assert bad_name.status_code == 422
 
