@@ -119,6 +119,25 @@ def _install_logging(stack: ExitStack, node: NodeRuntime) -> None:
     stack.callback(setattr, logging, "basicConfig", saved_basic_config)
 
 
+def _note_figure_saving(stack: ExitStack, node: NodeRuntime) -> None:
+    """Figure.savefig (which plt.savefig calls) tells the parent first: the step that saves a
+    figure gets the end budget (sandbox/limits.py), so plotting after a control loop is not cut
+    off by the step budget. matplotlib is imported by the warm pool before any student code."""
+    figure_module = sys.modules.get("matplotlib.figure")
+    if figure_module is None:
+        return
+    figure_class = figure_module.Figure
+    original = figure_class.savefig
+
+    def savefig(self: object, *args: object, **kwargs: object) -> object:
+        node.note_drawing()
+        return original(self, *args, **kwargs)
+
+    savefig.__doc__, savefig.__wrapped__ = original.__doc__, original  # type: ignore[attr-defined]
+    figure_class.savefig = savefig
+    stack.callback(setattr, figure_class, "savefig", original)
+
+
 def _environment(stack: ExitStack, node: NodeRuntime, load: Load, workdir: str) -> None:
     """Point the interpreter at this node; every change is undone when `stack` closes."""
     install_ros_compat()
@@ -144,6 +163,7 @@ def _environment(stack: ExitStack, node: NodeRuntime, load: Load, workdir: str) 
     warnings.simplefilter("default")
     warnings.showwarning = _show_warning
     _install_logging(stack, node)
+    _note_figure_saving(stack, node)
     lockstep = load.info.clock is Clock.LOCKSTEP
     stack.callback(TimePatch(node.clock, node.sleep_for, node.poll, clocks=lockstep).remove)
     runtime.activate(node)

@@ -29,6 +29,7 @@ from sandbox.logstream import LogStream
 from sandbox.protocol import (
     Api,
     Artifact,
+    Drawing,
     Envelope,
     Exited,
     Finishing,
@@ -219,12 +220,16 @@ class NodeProcess:
         has the end budget (limits.shutdown_budget_s) for its Exited: see `poll_finished`."""
         if self.state is not NodeState.RUNNING:
             raise NodeUsageError(f"node {self.name} is {self.state}, not waiting for a reply")
-        until = (
-            self._deadline
-            if timeout_s is None
-            else min(self._deadline, time.monotonic() + timeout_s)
-        )
-        reply = self._receive_until(until)
+        give_up = None if timeout_s is None else time.monotonic() + timeout_s
+        while True:
+            until = self._deadline if give_up is None else min(self._deadline, give_up)
+            reply = self._receive_until(until)
+            if not isinstance(reply, Drawing):
+                break
+            # Saving a figure may take seconds: this step gets the end budget instead.
+            self._expect(
+                max(self.limits.shutdown_budget_s, self._deadline - time.monotonic()), "drawing"
+            )
         if isinstance(reply, Yield):
             self._move(NodeState.SLEEPING)
             return reply
@@ -253,7 +258,10 @@ class NodeProcess:
             return self.exited
         if self.state is not NodeState.FINISHING:
             raise NodeUsageError(f"node {self.name} is {self.state}, not finishing")
-        reply = self._receive_until(min(self._deadline, time.monotonic() + timeout_s))
+        until = min(self._deadline, time.monotonic() + timeout_s)
+        reply = self._receive_until(until)
+        while isinstance(reply, Drawing):  # it has the end budget already
+            reply = self._receive_until(until)
         if isinstance(reply, Exited):
             self._finish(reply)
             return reply

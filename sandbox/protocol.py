@@ -172,6 +172,11 @@ class Yield(msgspec.Struct, tag=True, frozen=True):
     unsubscribed: list[str] = []
 
 
+class Drawing(msgspec.Struct, tag=True, frozen=True):
+    """The node started saving a figure: rendering a large PNG takes seconds, so the step it
+    is in gets the end budget instead of the step budget (sent at most once per wake)."""
+
+
 class Finishing(msgspec.Struct, tag=True, frozen=True):
     """The node has ended its part in the run (signal_shutdown(), its script returned or
     raised) and is finishing: shutdown hooks, figures, files. It will not sleep again; its
@@ -191,7 +196,7 @@ class Exited(msgspec.Struct, tag=True, frozen=True):
 
 
 ToChild = Load | Wake | Shutdown
-ToParent = Ready | Yield | Finishing | Exited
+ToParent = Ready | Yield | Drawing | Finishing | Exited
 
 
 class ProtocolError(RuntimeError):

@@ -33,6 +33,7 @@ from sandbox.msgs import Message, get_message_class
 from sandbox.names import Names
 from sandbox.protocol import (
     Clock,
+    Drawing,
     Envelope,
     Finishing,
     GraphTopic,
@@ -154,6 +155,7 @@ class NodeRuntime:
     wake_topics: set[str] = field(default_factory=set)  # always wake early (service requests)
     names: Names | None = None  # ROS name resolution for this node (sandbox.names)
     _polls: int = 0
+    _drawing_noted: bool = False
     _waiting: bool = False
     _main_thread: int = field(default_factory=threading.get_ident)
     _woken_ns: int = 0
@@ -368,6 +370,17 @@ class NodeRuntime:
         with contextlib.suppress(ROSInterruptException):
             self.wait_until(self.clock.now_ns())
 
+    def note_drawing(self) -> None:
+        """The student's code is saving a figure: tell the parent once per wake, so the step
+        gets the end budget (a 2400x1200 PNG can take longer than a control step may)."""
+        if self._drawing_noted or threading.get_ident() != self._main_thread:
+            return
+        self._drawing_noted = True
+        try:
+            self.link.send(Drawing())
+        except ProtocolError as error:
+            raise LinkLost(error) from error
+
     # ------------------------------------------------------------------ shutdown
     def on_shutdown(self, hook: Callable[[], Any]) -> None:
         self._hooks.append(hook)
@@ -478,6 +491,7 @@ class NodeRuntime:
             raise LinkLost(ProtocolError(f"expected Wake or Shutdown, got {type(reply).__name__}"))
         self.clock.wake(reply.time_s)
         self._polls, self._woken_ns, self._woken_wall_s = 0, self.clock.now_ns(), _wall_s()
+        self._drawing_noted = False
         if reply.graph is not None:
             self.graph = reply.graph
         self._deliver(reply.deliveries)

@@ -20,6 +20,7 @@ from sandbox.limits import DEFAULT_LIMITS, Limits
 from sandbox.msgs import Message
 from sandbox.protocol import (
     Api,
+    Drawing,
     Envelope,
     Exited,
     Finishing,
@@ -82,6 +83,7 @@ class Parent:
         self._encoder = msgspec.msgpack.Encoder()
         self.crash: BaseException | None = None
         self.finishing: Finishing | None = None
+        self.drawings = 0  # Drawing frames seen (a figure being saved)
         load = Load(textwrap.dedent(code), filename, api, info or crowbot_info("student"))
 
         def child() -> None:
@@ -104,6 +106,9 @@ class Parent:
                 assert self.crash is not None
                 raise self.crash
             frame = self._decoder.decode(data)
+            if isinstance(frame, Drawing):
+                self.drawings += 1
+                continue
             if isinstance(frame, Finishing):
                 assert self.finishing is None, "a node finishes once"
                 self.finishing = frame

@@ -3,6 +3,7 @@ artifacts and logs across the wall, budgets, misuse of the API."""
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 
 import pytest
@@ -10,7 +11,7 @@ import pytest
 from sandbox.bwrap import SandboxUnavailable
 from sandbox.launcher import DANGER, Launcher, NodeUsageError
 from sandbox.protocol import Api, Envelope, Exited, Finishing, Outcome, Yield
-from tests.sandbox.conftest import crowbot_info, run_script
+from tests.sandbox.conftest import TEST_LIMITS, crowbot_info, run_script
 
 COURSE_SCRIPT = """
 import time
@@ -143,3 +144,67 @@ def test_an_installed_server_under_usr_is_covered(monkeypatch, server_dir):
     command = bwrap.build_command(3, 1024 * 1024, ["x"])
     covered = [command[i + 1] for i, arg in enumerate(command) if arg == "--tmpfs"]
     assert server_dir in covered
+
+
+SLOW_FIGURE_AFTER_THE_LOOP = """
+import time
+import matplotlib.pyplot as plt
+from matplotlib.artist import Artist
+import rospy
+
+def slow():
+    start = time.process_time()
+    while time.process_time() - start < 1.5:
+        pass
+
+class SlowToDraw(Artist):
+    # Stands in for a large figure: rendering takes longer than the 1 s step budget.
+    def draw(self, renderer):
+        slow()
+
+rospy.init_node("plotter")
+for _ in range(3):
+    rospy.sleep(0.1)
+fig = plt.figure()
+fig.add_artist(SlowToDraw())
+fig.savefig("slow.png")
+rospy.sleep(0.1)
+"""
+
+
+@pytest.fixture(scope="module")
+def drawing_launcher():
+    """Short steps, and an end budget that 1.5 s of CPU fits even on a loaded machine."""
+    launcher = Launcher(limits=dataclasses.replace(TEST_LIMITS, shutdown_budget_s=30.0))
+    yield launcher
+    launcher.close()
+
+
+def test_saving_a_figure_gets_the_end_budget_not_the_step_budget(drawing_launcher):
+    launcher = drawing_launcher
+    assert launcher.limits.step_budget_s < 1.5 < launcher.limits.shutdown_budget_s
+    reply, node = run_script(launcher, SLOW_FIGURE_AFTER_THE_LOOP, "plotter")
+    try:
+        for k in range(1, 4):
+            assert isinstance(reply, Yield), reply
+            reply = node.wake(0.1 * k, [])
+        assert isinstance(reply, Yield), reply  # the figure was saved; the node slept again
+        reply = node.wake(0.4, [])
+        if isinstance(reply, Finishing):
+            reply = node.poll_finished(timeout_s=20.0)
+        assert isinstance(reply, Exited) and reply.outcome is Outcome.FINISHED, reply
+        assert [a.name for a in reply.artifacts] == ["slow.png"]
+    finally:
+        node.close()
+
+
+def test_a_computation_that_is_not_a_figure_still_has_the_step_budget(drawing_launcher):
+    code = SLOW_FIGURE_AFTER_THE_LOOP.replace('fig.savefig("slow.png")', "slow()")
+    reply, node = run_script(drawing_launcher, code, "spinner")
+    try:
+        for k in range(1, 4):
+            reply = node.wake(0.1 * k, [])
+        assert isinstance(reply, Exited) and reply.outcome is Outcome.KILLED, reply
+        assert "exceeded its 1 s step budget" in reply.reason
+    finally:
+        node.close()
