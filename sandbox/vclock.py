@@ -48,10 +48,13 @@ class NodeClock:
         self._anchor_ns = seconds_to_ns(start_time_s)  # run time at the last wake
         self._anchor_wall_ns = wall_monotonic_ns()
         self._last_ns = self._anchor_ns  # never hand out a time earlier than one already given
+        # Realtime: the run's clock starts once every node has loaded, so a node's clock stands
+        # at the start time until its first wake (else it would lead the run's by its load).
+        self._running = False
 
     def now_ns(self) -> int:
         now = self._anchor_ns
-        if self.mode is Clock.REALTIME:
+        if self.mode is Clock.REALTIME and self._running:
             now += wall_monotonic_ns() - self._anchor_wall_ns
         if now < self._last_ns:
             now = self._last_ns
@@ -67,7 +70,14 @@ class NodeClock:
         self._anchor_ns = self.now_ns() + duration_ns
 
     def wake(self, time_s: float) -> None:
-        self._anchor_ns = max(seconds_to_ns(time_s), self.now_ns())
+        if self.mode is Clock.REALTIME:
+            # The parent's clock is the truth: keeping our own reading when it is ahead would
+            # let every late wake add to a lead that never goes away. now_ns() still never
+            # goes backwards (it holds until the run's time catches up).
+            self._anchor_ns = seconds_to_ns(time_s)
+            self._running = True
+        else:  # lockstep: a busy node's own clock may have run past the wake (advance_ns)
+            self._anchor_ns = max(seconds_to_ns(time_s), self.now_ns())
         self._anchor_wall_ns = wall_monotonic_ns()
 
 

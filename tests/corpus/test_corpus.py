@@ -82,7 +82,6 @@ CASES = (
         "wall_approach",
         3.0,
         check_talker_listener,
-        # The listener first: a node loaded early runs ahead in realtime (see slow_neighbour).
         nodes=(Node("listener.py"), Node("talker.py")),
     ),
     Case(
@@ -209,10 +208,6 @@ CASES = (
         3.0,
         check_slow_neighbour,
         nodes=(Node("shutdown_stop.py"), Node("live_plot.py")),
-        realtime_needs=(
-            "a fix: in realtime a node's clock runs ahead of the run's by the start-up time "
-            "of the nodes loaded after it",
-        ),
     ),
     Case(
         "wait_for_scan",

@@ -368,3 +368,22 @@ def test_rosrun_arguments_reach_sys_argv_and_myargv_drops_remaps(
     assert "argv ['left', '_speed:=0.2', 'scan:=base_scan']" in out
     assert "myargv ['left']" in out
     assert "resolved /base_scan" in out
+
+
+def test_a_realtime_node_clock_follows_the_runs_not_its_own_load() -> None:
+    import time as wall
+
+    from sandbox.protocol import Clock
+    from sandbox.vclock import NodeClock
+
+    clock = NodeClock(Clock.REALTIME, 0.0)
+    wall.sleep(0.05)  # loading: the run's clock has not started yet
+    assert clock.now_ns() == 0
+    clock.wake(0.1)
+    assert 0.1 <= clock.now_s() < 0.13
+    wall.sleep(0.05)
+    ahead = clock.now_s()  # ~0.15
+    clock.wake(0.12)  # the parent's clock is behind ours: it wins, time does not go back
+    assert clock.now_s() >= ahead
+    wall.sleep(0.06)
+    assert clock.now_s() < ahead + 0.05  # no lead kept: ~0.18, not ~0.21
