@@ -55,7 +55,10 @@ WAKE_TOLERANCE_NS = 1_000  # [ns] a wake this close to the target counts as on t
 FREE_POLLS = 100  # [calls] polls between two wakes that cost no time
 POLL_COST_NS = 20_000  # [ns] what one poll past the free ones costs: a rospy publish() or
 # is_shutdown() round on a laptop takes 10-50 us
-BUSY_SLICE_NS = 1_000_000  # [ns] lockstep: a busy node yields after this much polled time
+# [ns] lockstep: a busy node yields after this much polled time. CPython hands the GIL from a
+# spinning thread to a waiting one every sys.getswitchinterval() = 5 ms by default, so in real
+# rospy a busy main loop lets its callback threads run about this often.
+BUSY_SLICE_NS = 5_000_000
 REALTIME_BUSY_SLICE_S = 0.01  # [s] realtime: a busy node yields after this much wall time
 
 

@@ -29,7 +29,7 @@ CROWBOT_SENSOR_AHEAD_M = 0.05  # [m] ultrasonic sensor ahead of the CrowBot's ce
 FIGURE_PX = (2400, 1200)  # [px] the CrowBot paper's figures: 12 x 6 in at 200 dpi
 STILL_M = 0.01  # [m] less than this between two poses: the robot stood still
 LOCKSTEP_SHARE = 0.9  # of the periods a lockstep run must show (start-up and end cost one each)
-REALTIME_SHARE = 0.8  # ... a realtime run must show (wake-ups come late on a loaded machine)
+REALTIME_SHARE = 0.6  # ... a realtime run must show (wake-ups come late on a loaded machine)
 
 
 def at_least(outcome: Outcome, rate_hz: float, seconds: float) -> int:
