@@ -21,7 +21,6 @@ measuring them, keeps lockstep runs reproducible.
 from __future__ import annotations
 
 import contextlib
-import difflib
 import sys
 import threading
 import traceback
@@ -40,15 +39,20 @@ from sandbox.protocol import (
     NodeInfo,
     ProtocolError,
     Shutdown,
-    TopicDecl,
     Wake,
     Yield,
 )
-from sandbox.services import NodeServices, is_internal
+from sandbox.ros_errors import (
+    ROSException,
+    ROSInitException,
+    ROSInterruptException,
+    ROSSerializationException,
+)
+from sandbox.services import NodeServices
 from sandbox.timers import TimerSchedule
+from sandbox.topic_table import ANY_TYPE, TopicTable
 from sandbox.vclock import NodeClock, wall_monotonic_ns
 
-ANY_TYPE = "*"  # rospy.AnyMsg's type name
 WAKE_TOLERANCE_NS = 1_000  # [ns] a wake this close to the target counts as on time (float s)
 # The busy-loop model (module docstring). A rate loop makes a few polls per wake and never pays;
 # a loop that never sleeps makes thousands.
@@ -60,23 +64,6 @@ POLL_COST_NS = 20_000  # [ns] what one poll past the free ones costs: a rospy pu
 # rospy a busy main loop lets its callback threads run about this often.
 BUSY_SLICE_NS = 5_000_000
 REALTIME_BUSY_SLICE_S = 0.01  # [s] realtime: a busy node yields after this much wall time
-
-
-# rospy's exception hierarchy (names and bases as in rospy.exceptions).
-class ROSException(Exception):
-    """Base of the errors the rospy API raises."""
-
-
-class ROSInitException(ROSException):
-    """The node is used before rospy.init_node() or initialised twice."""
-
-
-class ROSSerializationException(ROSException):
-    """A message could not be serialized (a field holds a value its type cannot encode)."""
-
-
-class ROSInterruptException(ROSException, KeyboardInterrupt):
-    """A sleep or wait was interrupted by shutdown."""
 
 
 class NodeFailure(BaseException):
@@ -131,19 +118,10 @@ class NodeRuntime:
     failure: BaseException | None = None
     log_sites: dict[tuple[Any, ...], int] = field(default_factory=dict)  # throttle/once state
     shutdown: _Shutdown | None = None
-    _types: dict[str, str] = field(default_factory=dict)  # topic -> type, robot's and new ones
-    _robot: dict[str, tuple[str, str]] = field(default_factory=dict)  # name -> (type, direction)
-    _advertised: set[str] = field(default_factory=set)
-    _latched: set[str] = field(default_factory=set)
-    _advertise_checked: dict[tuple[str, Any], str] = field(default_factory=dict)
-    _subscribed: set[str] = field(default_factory=set)
-    _new_advertised: list[TopicDecl] = field(default_factory=list)
-    _new_subscribed: list[TopicDecl] = field(default_factory=list)
     _subscribers: dict[str, list[Subscription]] = field(default_factory=dict)
     _hooks: list[Callable[[], Any]] = field(default_factory=list)
     _callback_depth: int = 0
     _in_hooks: bool = False
-    _warned_names: set[str] = field(default_factory=set)
     # The outbox keeps at most a publisher's queue_size messages per topic and burst (oldest
     # dropped, as rospy's publisher queue): entries are None once dropped. A burst is what one
     # callback, or the main loop between two waits, publishes: in rospy callbacks run as their
@@ -151,12 +129,12 @@ class NodeRuntime:
     _outbox_slots: list[Envelope | None] = field(default_factory=list)
     _outbox_by_topic: dict[tuple[str, int], list[int]] = field(default_factory=dict)
     _burst: int = 0
-    _unsubscribed: list[str] = field(default_factory=list)
     graph: list[GraphTopic] | None = None  # the run's topics, as of the last wake that sent it
     timers: TimerSchedule = field(default_factory=TimerSchedule)
     services: NodeServices = field(default_factory=NodeServices)
     wake_topics: set[str] = field(default_factory=set)  # always wake early (service requests)
     names: Names | None = None  # ROS name resolution for this node (sandbox.names)
+    topics: TopicTable = field(init=False)
     _polls: int = 0
     _drawing_noted: bool = False
     _waiting: bool = False
@@ -165,26 +143,12 @@ class NodeRuntime:
     _woken_wall_s: float = 0.0
 
     def __post_init__(self) -> None:
-        for topic in self.info.robot_topics:
-            self._robot[topic.name] = (topic.type, topic.direction)
-            self._types[topic.name] = topic.type
+        if self.names is None:
+            self.names = Names.from_info(self.info)
+        self.topics = TopicTable(self.info, self.names, self.warn)
         self.params = {normalize_param(key): value for key, value in self.info.params.items()}
         self._woken_ns = self.clock.now_ns()
         self._woken_wall_s = _wall_s()
-        if self.names is None:
-            self.names = Names.from_info(self.info)
-
-    def bus_name(self, topic: Any) -> str:
-        """The run's name for a topic this node names: resolved against the node's namespace
-        and name and remapped, as rospy does (sandbox.names); internal service topics as they
-        are."""
-        if isinstance(topic, str) and is_internal(topic):
-            return topic
-        if not isinstance(topic, str) or not topic.strip("/"):
-            raise ROSException(
-                f"a topic name is a non-empty string such as 'Distance', got {topic!r}"
-            )
-        return self.names.topic(topic)
 
     # ------------------------------------------------------------------ state and contracts
     @property
@@ -198,97 +162,25 @@ class NodeRuntime:
                 "top of the script"
             )
 
+    # The run's topic names and types this node knows (sandbox.topic_table).
+    def advertise(self, topic: str, data_class: Any, latch: bool = False) -> str:
+        """Check that this node may publish `data_class` on `topic`; return the bus name."""
+        return self.topics.advertise(topic, data_class, latch)
+
+    def bus_name(self, topic: Any) -> str:
+        return self.topics.bus_name(topic)
+
     def robot_direction(self, topic: str) -> str | None:
-        """ "publish" for the robot's sensor topics, "subscribe" for its command topics."""
-        entry = self._robot.get(topic)
-        return entry[1] if entry else None
+        return self.topics.robot_direction(topic)
 
     def sensor_topics(self) -> list[str]:
-        return [name for name, (_, way) in self._robot.items() if way == "publish"]
+        return self.topics.sensor_topics()
 
     def command_topics(self) -> list[str]:
-        return [name for name, (_, way) in self._robot.items() if way == "subscribe"]
+        return self.topics.command_topics()
 
-    def _close_robot_topic(self, name: str) -> str | None:
-        """One of the robot's topic names that `name` is probably a typo of, or None."""
-        by_lower = {topic.lower(): topic for topic in self._robot}
-        if name.lower() in by_lower:
-            return by_lower[name.lower()]
-        close = difflib.get_close_matches(name.lower(), list(by_lower), n=1, cutoff=0.8)
-        return by_lower[close[0]] if close else None
-
-    def _unknown_topic(self, name: str) -> ROSException:
-        close = self._close_robot_topic(name)
-        hint = f"did you mean '{close}'? " if close else ""
-        return ROSException(
-            f"unknown topic '{name}' on robot {self.info.robot}; {hint}its topics are "
-            f"{', '.join(self.sensor_topics())} (sensors) and "
-            f"{', '.join(self.command_topics())} (commands)"
-        )
-
-    def _new_topic(self, name: str) -> None:
-        """A topic that is not the robot's: allowed, as in rospy; refused only where the run
-        says so; a name close to a robot topic gets a warning once (a typo is a dead topic)."""
-        if not self.info.allow_new_topics:
-            raise self._unknown_topic(name)
-        close = self._close_robot_topic(name)
-        if close is not None and name not in self._warned_names:
-            self._warned_names.add(name)
-            self.warn(
-                f"'{name}' is not one of the topics of robot {self.info.robot}; did you mean "
-                f"'{close}'? (a new topic '{name}' was made; the robot does not see it)"
-            )
-
-    def _check_type(self, name: str, data_class: Any) -> str:
-        type_name = getattr(data_class, "_type", None)
-        if type_name == ANY_TYPE and isinstance(data_class, type):  # rospy.AnyMsg
-            known = self._types.get(name)
-            if known is None:
-                raise ROSException(
-                    f"rospy.AnyMsg on '{name}' needs a topic whose type is known (one of the "
-                    "robot's or one this node publishes); subscribe with the message class, "
-                    "e.g. std_msgs.msg.String"
-                )
-            return known
-        if not (isinstance(data_class, type) and issubclass(data_class, Message)):
-            raise ROSException(
-                f"topic '{name}' needs a message class such as std_msgs.msg.Int32 as its type, "
-                f"got {data_class!r}"
-            )
-        known = self._types.get(name)
-        if known is not None and known != type_name:
-            raise ROSException(f"topic '{name}' carries {known}, not {type_name}")
-        return type_name
-
-    def advertise(self, topic: str, data_class: Any, latch: bool = False) -> str:
-        """Check that this node may publish `data_class` on `topic`; return the clean name.
-        `latch`: later subscribers get the last message too (rospy's latch=True)."""
-        # Hot path: the step API and many scripts publish the same topic every period.
-        checked = self._advertise_checked.get((topic, data_class))
-        if checked is not None:
-            return checked
-        name = self.bus_name(topic)
-        robot = self._robot.get(name)
-        if robot is not None and robot[1] == "publish":
-            raise ROSException(
-                f"'{name}' is published by the robot; command topics are "
-                f"{', '.join(self.command_topics())}"
-            )
-        type_name = self._check_type(name, data_class)
-        if name not in self._types:
-            self._new_topic(name)
-        self._types[name] = type_name
-        if name not in self._advertised:
-            self._advertised.add(name)
-            self._new_advertised.append(TopicDecl(name, type_name, latch))
-        elif latch and name not in self._latched:
-            self._new_advertised.append(TopicDecl(name, type_name, latch))
-        if latch:
-            self._latched.add(name)
-            return name  # not cached: the plain entry must not hide a later latch
-        if isinstance(topic, str):
-            self._advertise_checked[(topic, data_class)] = name
-        return name
+    def unknown_topic(self, name: str) -> ROSException:
+        return self.topics.unknown_topic(name)
 
     def subscribe(
         self,
@@ -298,20 +190,7 @@ class NodeRuntime:
         args: Any = None,
         queue_size: int | None = None,
     ) -> Subscription:
-        name = self.bus_name(topic)
-        type_name = self._check_type(name, data_class)
-        if name not in self._types:
-            self._new_topic(name)
-        elif (
-            self._robot.get(name, ("", "publish"))[1] != "publish" and name not in self._advertised
-        ):
-            self.warn(f"'{name}' is a command topic the robot listens to; nothing publishes it")
-        self._types[name] = type_name
-        if name not in self._subscribed:
-            self._subscribed.add(name)
-            self._new_subscribed.append(TopicDecl(name, type_name))
-            if name in self._unsubscribed:
-                self._unsubscribed.remove(name)
+        name = self.topics.subscribe(topic, data_class)
         subscription = Subscription(name, data_class, callback, args, queue_size)
         self._subscribers.setdefault(name, []).append(subscription)
         return subscription
@@ -320,11 +199,9 @@ class NodeRuntime:
         handlers = self._subscribers.get(subscription.topic, [])
         if subscription in handlers:
             handlers.remove(subscription)
-        if not handlers and subscription.topic in self._subscribed:
+        if not handlers and subscription.topic in self._subscribers:
             # Nothing here listens any more: the parent stops queueing the topic for us.
-            self._subscribed.discard(subscription.topic)
-            self._new_subscribed = [d for d in self._new_subscribed if d.name != subscription.topic]
-            self._unsubscribed.append(subscription.topic)
+            self.topics.unsubscribe(subscription.topic)
             self._subscribers.pop(subscription.topic, None)
 
     def publish(self, topic: str, message: Message, queue_size: int | None = None) -> None:
@@ -347,10 +224,10 @@ class NodeRuntime:
         self.poll()
 
     def topic_class(self, topic: str) -> type[Message]:
-        return get_message_class(self._types[topic])
+        return get_message_class(self.topics.types[topic])
 
     def topic_type(self, topic: str) -> str | None:
-        return self._types.get(topic)
+        return self.topics.types.get(topic)
 
     # ------------------------------------------------------------------ busy loops
     def poll(self) -> None:
@@ -446,7 +323,7 @@ class NodeRuntime:
         if wake_at_ns is None and wake_on is None:  # spinning: any message wakes the node
             if timer_ns is None:
                 return None, None
-            return timer_ns, sorted(self._subscribed)
+            return timer_ns, sorted(self.topics.subscribed)
         topics = set(wake_on or ()) | self.wake_topics
         if timer_ns is not None:
             wake_at_ns = timer_ns if wake_at_ns is None else min(wake_at_ns, timer_ns)
@@ -470,15 +347,15 @@ class NodeRuntime:
         sys.stdout.flush()
         sys.stderr.flush()
         wake_at_ns, wake_on = self._effective_wake(wake_at_ns, wake_on)
+        advertised, subscribed, unsubscribed = self.topics.take_declarations()
         frame = Yield(
             wake_at_s=None if wake_at_ns is None else wake_at_ns / 1e9,
             published=self.take_outbox(),
-            advertised=self._new_advertised,
-            subscribed=self._new_subscribed,
+            advertised=advertised,
+            subscribed=subscribed,
             wake_on=wake_on,
-            unsubscribed=self._unsubscribed,
+            unsubscribed=unsubscribed,
         )
-        self._new_advertised, self._new_subscribed, self._unsubscribed = [], [], []
         self._waiting = True
         try:
             self.link.send(frame)

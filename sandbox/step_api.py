@@ -282,5 +282,5 @@ def _clean(topic: Any, node: NodeRuntime) -> str:
     try:
         node.topic_class(name)
     except KeyError:
-        raise node._unknown_topic(str(name)) from None
+        raise node.unknown_topic(str(name)) from None
     return name
