@@ -116,8 +116,11 @@ def check_square(outcome: Outcome) -> None:
     start, end = outcome.start, outcome.end
     farthest = max(math.hypot(p.x - start.x, p.y - start.y) for p in outcome.poses)
     assert 0.25 <= farthest <= 0.5, farthest  # a 0.3 m square's diagonal is 0.42 m
-    assert math.hypot(end.x - start.x, end.y - start.y) < 0.15, end
-    assert outcome.turned() == pytest.approx(2 * math.pi, abs=0.6)
+    # Open loop: in realtime each side and turn lasts as long as the wall clock says, so a
+    # loaded machine's late wake-ups leave a larger gap, as on a real robot.
+    realtime = outcome.clock is Clock.REALTIME
+    assert math.hypot(end.x - start.x, end.y - start.y) < (0.3 if realtime else 0.15), end
+    assert outcome.turned() == pytest.approx(2 * math.pi, abs=1.0 if realtime else 0.6)
     assert_log(outcome, "square_time_now", r"side 4")
     assert_log(outcome, "square_time_now", r"square done")
 
