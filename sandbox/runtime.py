@@ -10,12 +10,8 @@ subscriber callbacks in delivery order and then the timers that fell due (rospy 
 threads of their own; here they run inside the node's waits); on `Shutdown` it runs the
 on_shutdown hooks and raises `ROSInterruptException`.
 
-A node that never sleeps (`while not rospy.is_shutdown(): pub.publish(...)`) still sees time
-pass and callbacks run, as on a real robot: past `FREE_POLLS` calls of is_shutdown(),
-Time.now(), publish() and the clock functions since its last wake, each such call costs
-`POLL_COST_NS` of simulated time (lockstep), and every `BUSY_SLICE_NS` of it (realtime:
-`REALTIME_BUSY_SLICE_S` of wall time) the node yields as if it had slept. Counting calls, not
-measuring them, keeps lockstep runs reproducible.
+A node that never sleeps still sees time pass and callbacks run, as on a real robot: the
+functions such a loop spins on call `poll()`, which yields now and then (sandbox/busy_loop.py).
 """
 
 from __future__ import annotations
@@ -28,10 +24,11 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
+from sandbox.busy_loop import BusyLoopModel
 from sandbox.msgs import Message, get_message_class
 from sandbox.names import Names
+from sandbox.outbox import Outbox
 from sandbox.protocol import (
-    Clock,
     Drawing,
     Envelope,
     Finishing,
@@ -51,19 +48,9 @@ from sandbox.ros_errors import (
 from sandbox.services import NodeServices
 from sandbox.timers import TimerSchedule
 from sandbox.topic_table import ANY_TYPE, TopicTable
-from sandbox.vclock import NodeClock, wall_monotonic_ns
+from sandbox.vclock import NodeClock
 
 WAKE_TOLERANCE_NS = 1_000  # [ns] a wake this close to the target counts as on time (float s)
-# The busy-loop model (module docstring). A rate loop makes a few polls per wake and never pays;
-# a loop that never sleeps makes thousands.
-FREE_POLLS = 100  # [calls] polls between two wakes that cost no time
-POLL_COST_NS = 20_000  # [ns] what one poll past the free ones costs: a rospy publish() or
-# is_shutdown() round on a laptop takes 10-50 us
-# [ns] lockstep: a busy node yields after this much polled time. CPython hands the GIL from a
-# spinning thread to a waiting one every sys.getswitchinterval() = 5 ms by default, so in real
-# rospy a busy main loop lets its callback threads run about this often.
-BUSY_SLICE_NS = 5_000_000
-REALTIME_BUSY_SLICE_S = 0.01  # [s] realtime: a busy node yields after this much wall time
 
 
 class NodeFailure(BaseException):
@@ -122,33 +109,24 @@ class NodeRuntime:
     _hooks: list[Callable[[], Any]] = field(default_factory=list)
     _callback_depth: int = 0
     _in_hooks: bool = False
-    # The outbox keeps at most a publisher's queue_size messages per topic and burst (oldest
-    # dropped, as rospy's publisher queue): entries are None once dropped. A burst is what one
-    # callback, or the main loop between two waits, publishes: in rospy callbacks run as their
-    # messages arrive, spread in time, so the queue's writer drains between them.
-    _outbox_slots: list[Envelope | None] = field(default_factory=list)
-    _outbox_by_topic: dict[tuple[str, int], list[int]] = field(default_factory=dict)
-    _burst: int = 0
+    outbox: Outbox = field(default_factory=Outbox)  # what leaves at the next yield
     graph: list[GraphTopic] | None = None  # the run's topics, as of the last wake that sent it
     timers: TimerSchedule = field(default_factory=TimerSchedule)
     services: NodeServices = field(default_factory=NodeServices)
     wake_topics: set[str] = field(default_factory=set)  # always wake early (service requests)
     names: Names | None = None  # ROS name resolution for this node (sandbox.names)
     topics: TopicTable = field(init=False)
-    _polls: int = 0
     _drawing_noted: bool = False
     _waiting: bool = False
     _main_thread: int = field(default_factory=threading.get_ident)
-    _woken_ns: int = 0
-    _woken_wall_s: float = 0.0
+    busy: BusyLoopModel = field(init=False)
 
     def __post_init__(self) -> None:
         if self.names is None:
             self.names = Names.from_info(self.info)
         self.topics = TopicTable(self.info, self.names, self.warn)
         self.params = {normalize_param(key): value for key, value in self.info.params.items()}
-        self._woken_ns = self.clock.now_ns()
-        self._woken_wall_s = _wall_s()
+        self.busy = BusyLoopModel(self.clock)
 
     # ------------------------------------------------------------------ state and contracts
     @property
@@ -213,14 +191,7 @@ class NodeRuntime:
             data = message.serialize()
         except Exception as error:
             raise ROSSerializationException(f"publish() on '{topic}': {error}") from None
-        key = (topic, self._burst)
-        indexes = self._outbox_by_topic.get(key)
-        if indexes is None:
-            indexes = self._outbox_by_topic[key] = []
-        indexes.append(len(self._outbox_slots))
-        self._outbox_slots.append(Envelope(topic, message._type, data))
-        if queue_size and len(indexes) > queue_size:
-            self._outbox_slots[indexes.pop(0)] = None
+        self.outbox.add(Envelope(topic, message._type, data), queue_size)
         self.poll()
 
     def topic_class(self, topic: str) -> type[Message]:
@@ -233,18 +204,13 @@ class NodeRuntime:
     def poll(self) -> None:
         """One call of a function a busy loop spins on (module docstring): past the free
         polls it costs time, and now and then the node yields as if it slept."""
-        self._polls += 1
-        if self._polls <= FREE_POLLS or self._callback_depth or self.shutdown is not None:
+        if self._callback_depth or self.shutdown is not None:
             return
         if self._waiting:
             return  # a clock read inside our own wait (the link, logging) is not the student's
         if threading.get_ident() != self._main_thread:
             return  # only the node's own thread may talk to the parent
-        if self.info.clock is Clock.LOCKSTEP:
-            self.clock.advance_ns(POLL_COST_NS)
-            if self.clock.now_ns() - self._woken_ns < BUSY_SLICE_NS:
-                return
-        elif _wall_s() - self._woken_wall_s < REALTIME_BUSY_SLICE_S:
+        if not self.busy.count():
             return
         # The run may end meanwhile: is_shutdown() says so from now on.
         with contextlib.suppress(ROSInterruptException):
@@ -299,7 +265,7 @@ class NodeRuntime:
 
     def _run_student(self, function: Callable[..., Any], *args: Any) -> None:
         """Call student code from inside a sleep; its exception ends the node."""
-        self._burst += 1
+        self.outbox.new_burst()
         self._callback_depth += 1
         try:
             function(*args)
@@ -311,9 +277,7 @@ class NodeRuntime:
 
     # ------------------------------------------------------------------ sleeping
     def take_outbox(self) -> list[Envelope]:
-        sent = [envelope for envelope in self._outbox_slots if envelope is not None]
-        self._outbox_slots, self._outbox_by_topic = [], {}
-        return sent
+        return self.outbox.take()
 
     def _effective_wake(
         self, wake_at_ns: int | None, wake_on: list[str] | None
@@ -370,7 +334,7 @@ class NodeRuntime:
         if not isinstance(reply, Wake):
             raise LinkLost(ProtocolError(f"expected Wake or Shutdown, got {type(reply).__name__}"))
         self.clock.wake(reply.time_s)
-        self._polls, self._woken_ns, self._woken_wall_s = 0, self.clock.now_ns(), _wall_s()
+        self.busy.woke()
         self._drawing_noted = False
         if reply.graph is not None:
             self.graph = reply.graph
@@ -381,7 +345,7 @@ class NodeRuntime:
                     self._run_student(timer.fire, self.clock.now_ns())
                 if self.shutdown is not None:
                     break
-        self._burst += 1  # back in the main loop
+        self.outbox.new_burst()  # back in the main loop
         if self.shutdown is not None:  # a callback called signal_shutdown()
             raise ROSInterruptException(f"ROS shutdown request: {self.shutdown.reason}")
 
@@ -433,11 +397,6 @@ class NodeRuntime:
 
     def warn(self, text: str) -> None:
         self.log("WARN", text)
-
-
-def _wall_s() -> float:
-    """The real monotonic clock [s] (the `time` module's is the node's clock in lockstep)."""
-    return wall_monotonic_ns() / 1e9
 
 
 def _callable_name(function: Any) -> str:

@@ -9,10 +9,10 @@ from pathlib import Path
 
 import pytest
 
+from sandbox.busy_loop import BUSY_SLICE_NS, FREE_POLLS, POLL_COST_NS
 from sandbox.msgs.geometry_msgs import Twist
 from sandbox.msgs.std_msgs import Int32
 from sandbox.protocol import Outcome
-from sandbox.runtime import BUSY_SLICE_NS, FREE_POLLS, POLL_COST_NS
 from tests.sandbox.test_host_harness import Parent, crowbot_info, envelope, run
 
 TALKER_BEFORE_INIT = """
