@@ -172,6 +172,8 @@ def _environment(stack: ExitStack, node: NodeRuntime, load: Load, workdir: str) 
 
 def _execute(node: NodeRuntime, load: Load) -> None:
     """Compile and run the student's module (and its steps); raises what the student raised."""
+    if node.failure is not None:  # the node's names could not be set up (a bad remap)
+        raise node.failure
     tree = compile(load.code, load.filename, "exec", flags=ast.PyCF_ONLY_AST, dont_inherit=True)
     code = compile(tree, load.filename, "exec", dont_inherit=True)
     api = choose_api(tree, load.api)

@@ -26,7 +26,7 @@ from typing import Any
 
 from sandbox.busy_loop import BusyLoopModel
 from sandbox.msgs import Message, get_message_class
-from sandbox.names import Names
+from sandbox.names import InvalidName, Names
 from sandbox.outbox import Outbox
 from sandbox.protocol import (
     Drawing,
@@ -100,7 +100,6 @@ class NodeRuntime:
     node_name: str | None = None  # "/name" once init_node() ran (or the step API started)
     implicit_name: bool = False  # named by the step API; init_node() may rename it
     log_level: int = 2  # rospy.INFO
-    params: dict[str, Any] = field(default_factory=dict)
     latest: dict[str, Envelope] = field(default_factory=dict)
     failure: BaseException | None = None
     log_sites: dict[tuple[Any, ...], int] = field(default_factory=dict)  # throttle/once state
@@ -123,9 +122,12 @@ class NodeRuntime:
 
     def __post_init__(self) -> None:
         if self.names is None:
-            self.names = Names.from_info(self.info)
+            try:
+                self.names = Names.from_info(self.info)
+            except InvalidName as error:  # a bad remap or __ns on the node's command line
+                self.failure = ROSInitException(f"this node's command line or launch file: {error}")
+                self.names = Names(run_name=self.info.node_name)
         self.topics = TopicTable(self.info, self.names, self.warn)
-        self.params = {normalize_param(key): value for key, value in self.info.params.items()}
         self.busy = BusyLoopModel(self.clock)
 
     # ------------------------------------------------------------------ state and contracts
@@ -416,10 +418,6 @@ def _student_traceback(error: BaseException, filename: str) -> str:
 def format_log_line(level_name: str, time_s: float, text: str) -> str:
     """rospy's screen format: `[INFO] [12.300000]: text`."""
     return f"[{level_name}] [{time_s:.6f}]: {text}"
-
-
-def normalize_param(name: str) -> str:
-    return str(name).lstrip("/~")
 
 
 _current: NodeRuntime | None = None

@@ -387,3 +387,14 @@ def test_a_realtime_node_clock_follows_the_runs_not_its_own_load() -> None:
     assert clock.now_s() >= ahead
     wall.sleep(0.06)
     assert clock.now_s() < ahead + 0.05  # no lead kept: ~0.18, not ~0.21
+
+
+def test_a_bad_remap_on_the_command_line_is_a_sentence_not_a_crash(tmp_path: Path) -> None:
+    _, exited = run(
+        "import rospy\nrospy.init_node('n')\n",
+        tmp_path,
+        info=crowbot_info(argv=["scan:=9bad name"]),
+    )
+    assert exited.outcome is Outcome.ERROR
+    assert exited.error.type == "ROSInitException"
+    assert exited.error.message.startswith("this node's command line or launch file:")
