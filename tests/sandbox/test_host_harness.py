@@ -24,6 +24,7 @@ from sandbox.protocol import (
     Envelope,
     Exited,
     Finishing,
+    GraphTopic,
     Load,
     NodeInfo,
     Outcome,
@@ -123,8 +124,13 @@ class Parent:
         before = self.finishing.published if self.finishing is not None else []
         return [*before, *exited.published]
 
-    def wake(self, time_s: float, deliveries: Iterable[Envelope] = ()) -> Yield | Exited:
-        self.link.to_child.put(self._encoder.encode(Wake(time_s, list(deliveries))))
+    def wake(
+        self,
+        time_s: float,
+        deliveries: Iterable[Envelope] = (),
+        graph: list[GraphTopic] | None = None,
+    ) -> Yield | Exited:
+        self.link.to_child.put(self._encoder.encode(Wake(time_s, list(deliveries), graph)))
         return self.next()
 
     def shutdown(self, reason: str = "stop pressed") -> Exited:

@@ -12,7 +12,7 @@ import pytest
 from sandbox.busy_loop import BUSY_SLICE_NS, FREE_POLLS, POLL_COST_NS
 from sandbox.msgs.geometry_msgs import Twist
 from sandbox.msgs.std_msgs import Int32
-from sandbox.protocol import Outcome
+from sandbox.protocol import GraphTopic, Outcome
 from tests.sandbox.test_host_harness import Parent, crowbot_info, envelope, run
 
 TALKER_BEFORE_INIT = """
@@ -398,3 +398,23 @@ def test_a_bad_remap_on_the_command_line_is_a_sentence_not_a_crash(tmp_path: Pat
     assert exited.outcome is Outcome.ERROR
     assert exited.error.type == "ROSInitException"
     assert exited.error.message.startswith("this node's command line or launch file:")
+
+
+def test_waiting_for_a_subscriber_without_sleeping_sees_the_graph_change(tmp_path: Path) -> None:
+    parent = Parent(
+        """
+        import rospy
+        from std_msgs.msg import String
+        rospy.init_node('announcer')
+        pub = rospy.Publisher('news', String, queue_size=1)
+        while pub.get_num_connections() < 1:
+            pass
+        pub.publish("someone is listening")
+        """,
+        tmp_path,
+    )
+    frame = parent.next()  # a busy yield: the graph comes with the next wake
+    graph = [GraphTopic("news", "std_msgs/String", ["announcer"], ["reader"])]
+    frame = parent.wake(frame.wake_at_s, [], graph)
+    assert frame.outcome is Outcome.FINISHED, frame.error
+    assert [e.topic for e in parent.last_published(frame)] == ["news"]

@@ -126,6 +126,8 @@ class Subscriber:
 
 
 def _connections(node: _runtime.NodeRuntime, topic: str, side: str) -> int:
+    # `while pub.get_num_connections() < 1: pass` is a busy loop waiting for the graph
+    node.poll()
     me = (node.info.node_name or "").strip("/")
     for entry in node.graph or ():
         if entry.name == topic:
