@@ -35,6 +35,7 @@ from dataclasses import dataclass
 from itertools import islice
 from typing import Any
 
+from sandbox.services import is_internal
 from server.runs.state import RunState
 from server.service.decode import decode
 
@@ -105,6 +106,8 @@ class RunTelemetry:
 
     # ------------------------------------------------------------------- RunObserver (run thread)
     def on_message(self, topic: str, type_name: str, time_ns: int, data: bytes) -> None:
+        if is_internal(topic):
+            return  # a service's request/answer topics: in the recording, not for plots
         previous = self._latest.get(topic)
         if previous is None:
             with self._lock:

@@ -409,6 +409,8 @@ def test_snapshot() -> None:
     telemetry.on_state(RunState.STARTING, "", 0.0)
     telemetry.on_message("scan", "sensor_msgs/LaserScan", 0, b"")
     telemetry.on_message("count", INT32, 0, int32(1))
+    # A service's internal request topic is recorded, not offered to viewers.
+    telemetry.on_message("__srv__/enable", "robodojo_msgs/ServiceCall", 0, b"")
     assert telemetry.snapshot() == {
         "type": "snapshot",
         "run_id": "r15",
