@@ -8,6 +8,7 @@ import pytest
 from mcap.reader import make_reader
 
 from sandbox.msgs.geometry_msgs import Twist
+from sandbox.msgs.std_msgs import Int32
 from sandbox.protocol import Clock
 from server.runs.run import Run
 from server.runs.spec import NodeSpec, RunSpec
@@ -159,8 +160,6 @@ def test_a_busy_loop_drives_the_robot_and_sees_its_sensor(tmp_path, launcher, cl
     assert result.state is RunState.FINISHED, result.reason
     assert result.reason == "finished: duration reached"
     # It drove from 60 cm and stopped near 25 cm: its callback saw the wall coming.
-    from sandbox.msgs.std_msgs import Int32
-
     readings = [Int32.deserialize(d).data for _, d in recorded(tmp_path / "run", "Distance")]
     assert readings[0] > 50
     assert 18 <= readings[-1] <= 27, readings[-20:]
