@@ -202,6 +202,13 @@ class NodeRuntime:
     def topic_type(self, topic: str) -> str | None:
         return self.topics.types.get(topic)
 
+    def current_graph(self) -> list[GraphTopic]:
+        """The run's topic graph; before the first wake the node has none yet, so it asks for
+        it with a zero-length wait (the parent sends it with that wake)."""
+        if self.graph is None:
+            self.wait_until(self.clock.now_ns())
+        return self.graph or []
+
     # ------------------------------------------------------------------ busy loops
     def poll(self) -> None:
         """One call of a function a busy loop spins on (module docstring): past the free

@@ -149,10 +149,8 @@ class NodeServices:
 
     # ------------------------------------------------------------------ client side
     def available(self, node: NodeRuntime, name: str) -> bool:
-        if node.graph is None:  # before the first wake: ask the parent for the graph
-            node.wait_until(node.clock.now_ns())
         topic = request_topic(name)
-        return any(t.name == topic and t.subscribers for t in node.graph or ())
+        return any(t.name == topic and t.subscribers for t in node.current_graph())
 
     def call(self, node: NodeRuntime, name: str, service_class: Any, request: Message) -> Message:
         own = self.served.get(name)

@@ -15,7 +15,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
-from sandbox.msgs import Duration, Time
+from sandbox.msgs import Time
 
 
 class TimerEvent:
@@ -124,10 +124,3 @@ class TimerSchedule:
                 missed = (now_ns - timer.next_ns) // timer.period_ns + 1
                 timer.next_ns += missed * timer.period_ns
         return due
-
-
-def period_ns(period: Any) -> int:
-    """A rospy.Duration or a number of seconds, in [ns]."""
-    if isinstance(period, Duration):
-        return period.to_nsec()
-    return round(float(period) * 1e9)

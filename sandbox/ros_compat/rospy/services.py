@@ -11,9 +11,11 @@ from collections.abc import Callable
 from typing import Any
 
 from sandbox import runtime as _runtime
-from sandbox.msgs import Duration, Message
+from sandbox.msgs import Message
 from sandbox.runtime import ROSException, ROSSerializationException
 from sandbox.services import AVAILABILITY_POLL_NS, ServiceException
+
+from .timing import duration_ns
 
 
 def _service_name(name: Any) -> str:
@@ -31,20 +33,16 @@ def _check_class(service_class: Any, what: str) -> None:
         )
 
 
-def _seconds(timeout: Any) -> float:
-    return timeout.to_sec() if isinstance(timeout, Duration) else float(timeout)
-
-
 def wait_for_service(service: str, timeout: Any = None) -> None:
     """Wait until some node of the run serves `service`; ROSException after `timeout` [s]."""
     node = _runtime.current()
     name = _service_name(service)
     deadline = None
     if timeout is not None:
-        seconds = _seconds(timeout)
-        if seconds == 0.0:
+        timeout_ns = duration_ns(timeout, "rospy.wait_for_service()")
+        if timeout_ns == 0:
             raise ValueError("timeout must be non-zero")
-        deadline = node.clock.now_ns() + round(seconds * 1e9)
+        deadline = node.clock.now_ns() + timeout_ns
     while not node.services.available(node, name):
         now = node.clock.now_ns()
         if deadline is not None and now >= deadline:

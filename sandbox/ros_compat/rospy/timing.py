@@ -39,7 +39,7 @@ def get_time() -> float:
     return node.clock.now_ns() / 1e9
 
 
-def _duration_ns(duration: Any, what: str) -> int:
+def duration_ns(duration: Any, what: str) -> int:
     if isinstance(duration, Duration):
         return duration.to_nsec()
     if isinstance(duration, Real) and not isinstance(duration, bool):
@@ -53,7 +53,7 @@ def sleep(duration: Any) -> None:
     node.require_init("rospy.sleep()")
     if node.is_shutdown:
         raise ROSInterruptException("ROS shutdown request")
-    node.sleep_until(node.clock.now_ns() + max(0, _duration_ns(duration, "rospy.sleep()")))
+    node.sleep_until(node.clock.now_ns() + max(0, duration_ns(duration, "rospy.sleep()")))
 
 
 class Rate:
@@ -109,7 +109,7 @@ class Timer:
             raise TypeError(
                 f"rospy.Timer(period, callback): callback must be a function, got {callback!r}"
             )
-        period_ns = _duration_ns(period, "rospy.Timer()")
+        period_ns = duration_ns(period, "rospy.Timer()")
         if period_ns <= 0:
             raise ValueError(f"rospy.Timer() needs a positive period, got {period!r}")
         self._period = Duration.from_nsec(period_ns)
@@ -129,7 +129,7 @@ class Timer:
         node = _runtime.current()
         step_ns = self._period.to_nsec()
         deadline = (
-            None if timeout is None else node.clock.now_ns() + _duration_ns(timeout, "Timer.join()")
+            None if timeout is None else node.clock.now_ns() + duration_ns(timeout, "Timer.join()")
         )
         while self.is_alive() and not node.is_shutdown:
             if deadline is not None and node.clock.now_ns() >= deadline:

@@ -13,6 +13,8 @@ from sandbox import runtime as _runtime
 from sandbox.msgs import Message
 from sandbox.runtime import ROSException
 
+from .timing import duration_ns
+
 
 class Publisher:
     def __init__(
@@ -145,8 +147,7 @@ def wait_for_message(topic: str, topic_type: type[Message], timeout: float | Non
     subscription = node.subscribe(topic, topic_type, received.append)
     deadline = None
     if timeout is not None:
-        seconds = timeout.to_sec() if hasattr(timeout, "to_sec") else float(timeout)
-        deadline = node.clock.now_ns() + round(seconds * 1e9)
+        deadline = node.clock.now_ns() + duration_ns(timeout, "rospy.wait_for_message()")
     try:
         while not received:
             if deadline is not None and node.clock.now_ns() >= deadline:
@@ -179,11 +180,10 @@ def get_published_topics(namespace: str = "/") -> list[list[str]]:
     from sandbox.services import is_internal
 
     node = _runtime.current()
-    if node.graph is None:  # before the first wake: ask the parent for the graph
-        node.wait_until(node.clock.now_ns())
+    graph = node.current_graph()
     prefix = "/" + namespace.strip("/")
     found = []
-    for entry in node.graph or ():
+    for entry in graph:
         name = "/" + entry.name
         under = prefix == "/" or name == prefix or name.startswith(prefix + "/")
         if entry.publishers and not is_internal(entry.name) and under:
