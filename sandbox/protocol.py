@@ -94,10 +94,14 @@ class NodeInfo(msgspec.Struct, frozen=True):
     remaps: dict[str, str] = {}
     # The node's namespace (a launch file's <group ns="...">, or <node ns="...">).
     namespace: str = "/"
+    # 1: rospy; 2: rclpy. A run is one or the other (docs/architecture.md, "ROS 2"): for 2 every
+    # type name is a ROS 2 name ("std_msgs/msg/Int32") and every Envelope carries CDR bytes.
+    ros_version: int = 1
 
 
 class Envelope(msgspec.Struct, array_like=True, frozen=True):
-    """One ROS message on a topic: its type name and ROS1-serialized bytes."""
+    """One ROS message on a topic: its type name and serialized bytes (ROS1 wire format in a
+    ROS 1 run, CDR with its encapsulation header in a ROS 2 run; NodeInfo.ros_version)."""
 
     topic: str
     type: str
