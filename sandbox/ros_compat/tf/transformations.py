@@ -1,111 +1,20 @@
-"""`tf.transformations` for student code: 4x4 homogeneous transforms, Euler angles and
-quaternions, with the names and conventions of the module ROS 1 ships in the `tf` package
-(C. Gohlke's transformations.py): quaternions are [x, y, z, w]; Euler conventions are the 24
-axes strings such as 'sxyz' (the default: static x, y, z, i.e. roll, pitch, yaw) or their
-4-tuples; angles are in radians; results are numpy arrays.
+"""`tf.transformations` for student code, with the names and conventions of the module ROS 1
+ships in the `tf` package (C. Gohlke's transformations.py): quaternions are [x, y, z, w]; Euler
+conventions are the 24 axes strings such as 'sxyz' (the default: roll, pitch, yaw about the
+static x, y, z axes); angles are in radians; results are numpy arrays.
 
     from tf.transformations import euler_from_quaternion, quaternion_from_euler
     q = msg.pose.pose.orientation
     roll, pitch, yaw = euler_from_quaternion([q.x, q.y, q.z, q.w])
 
-Written here from the published math (see the sources in _rotations.py and _affine.py).
+The math lives in sandbox/transformations, shared with ROS 2's tf_transformations.
 """
 
-from ._affine import (
-    clip_matrix,
-    compose_matrix,
-    decompose_matrix,
-    orthogonalization_matrix,
-    projection_from_matrix,
-    projection_matrix,
-    reflection_from_matrix,
-    reflection_matrix,
-    scale_from_matrix,
-    scale_matrix,
-    shear_from_matrix,
-    shear_matrix,
-    superimposition_matrix,
-)
-from ._arcball import (
-    Arcball,
-    arcball_constrain_to_axis,
-    arcball_map_to_sphere,
-    arcball_nearest_axis,
-)
-from ._rotations import (
+from sandbox.transformations import *  # noqa: F403
+from sandbox.transformations import (  # noqa: F401  (scripts read these private names)
     _AXES2TUPLE,
+    _EPS,
     _NEXT_AXIS,
     _TUPLE2AXES,
-    euler_from_matrix,
-    euler_from_quaternion,
-    euler_matrix,
-    quaternion_about_axis,
-    quaternion_conjugate,
-    quaternion_from_euler,
-    quaternion_from_matrix,
-    quaternion_inverse,
-    quaternion_matrix,
-    quaternion_multiply,
-    quaternion_slerp,
-    random_quaternion,
-    random_rotation_matrix,
-    rotation_from_matrix,
-    rotation_matrix,
+    __all__,
 )
-from ._vectors import EPS as _EPS
-from ._vectors import (
-    concatenate_matrices,
-    identity_matrix,
-    inverse_matrix,
-    is_same_transform,
-    random_vector,
-    translation_from_matrix,
-    translation_matrix,
-    unit_vector,
-    vector_norm,
-)
-
-__all__ = [
-    "Arcball",
-    "arcball_constrain_to_axis",
-    "arcball_map_to_sphere",
-    "arcball_nearest_axis",
-    "clip_matrix",
-    "compose_matrix",
-    "concatenate_matrices",
-    "decompose_matrix",
-    "euler_from_matrix",
-    "euler_from_quaternion",
-    "euler_matrix",
-    "identity_matrix",
-    "inverse_matrix",
-    "is_same_transform",
-    "orthogonalization_matrix",
-    "projection_from_matrix",
-    "projection_matrix",
-    "quaternion_about_axis",
-    "quaternion_conjugate",
-    "quaternion_from_euler",
-    "quaternion_from_matrix",
-    "quaternion_inverse",
-    "quaternion_matrix",
-    "quaternion_multiply",
-    "quaternion_slerp",
-    "random_quaternion",
-    "random_rotation_matrix",
-    "random_vector",
-    "reflection_from_matrix",
-    "reflection_matrix",
-    "rotation_from_matrix",
-    "rotation_matrix",
-    "scale_from_matrix",
-    "scale_matrix",
-    "shear_from_matrix",
-    "shear_matrix",
-    "superimposition_matrix",
-    "translation_from_matrix",
-    "translation_matrix",
-    "unit_vector",
-    "vector_norm",
-]
-_PRIVATE_NAMES_SCRIPTS_READ = (_AXES2TUPLE, _TUPLE2AXES, _NEXT_AXIS, _EPS)
