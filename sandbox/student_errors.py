@@ -17,6 +17,12 @@ from sandbox.protocol import NodeError
 
 _SANDBOX_DIR = os.path.dirname(os.path.abspath(__file__))
 _ROS_COMPAT_DIR = os.path.join(_SANDBOX_DIR, "ros_compat")
+# Student-facing libraries of the sandbox outside ros_compat (shared by both ROS versions),
+# named as the student imports them.
+_SHARED_LIBRARIES = {
+    os.path.join(_SANDBOX_DIR, "tf2"): "tf2_ros",
+    os.path.join(_SANDBOX_DIR, "transformations"): "transformations",
+}
 _STDLIB_DIR = sysconfig.get_paths()["stdlib"]
 
 
@@ -76,6 +82,9 @@ def _library_of(path: str) -> str:
             return rest[0].removesuffix(".py") if rest else marker
     if path.startswith(_ROS_COMPAT_DIR + os.sep):
         return os.path.relpath(path, _ROS_COMPAT_DIR).split(os.sep)[0]
+    for directory, library in _SHARED_LIBRARIES.items():
+        if path.startswith(directory + os.sep):
+            return library
     if path.startswith(_SANDBOX_DIR + os.sep):
         return "the RoboDojo node host"
     if path.startswith(_STDLIB_DIR + os.sep):

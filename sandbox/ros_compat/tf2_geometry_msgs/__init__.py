@@ -3,6 +3,7 @@ registrations that let tf2_ros's buffer.transform() take geometry_msgs stamped m
 
 from .tf2_geometry_msgs import (
     do_transform_point,
+    do_transform_polygon_stamped,
     do_transform_pose,
     do_transform_pose_stamped,
     do_transform_pose_with_covariance_stamped,
@@ -15,6 +16,7 @@ from .tf2_geometry_msgs import (
 
 __all__ = [
     "do_transform_point",
+    "do_transform_polygon_stamped",
     "do_transform_pose",
     "do_transform_pose_stamped",
     "do_transform_pose_with_covariance_stamped",
