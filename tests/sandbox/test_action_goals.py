@@ -1,10 +1,11 @@
-"""The action server's goal bookkeeping: rcl_action's state machine and cancel policy."""
+"""An action server's goal bookkeeping (sandbox/action_goals.py): rcl_action's state machine
+and cancel policy."""
 
 from __future__ import annotations
 
 import pytest
 
-from server.runs.nav2_goals import (
+from sandbox.action_goals import (
     ZERO_UUID,
     ActionGoals,
     CancelCode,
@@ -76,3 +77,16 @@ def test_result_requests_wait_for_the_end_and_unknown_goals_answer_at_once():
     assert goals.result_request(uuid(1), "caller-d") == (True, goal)  # ended: answered now
     assert goals.status_list() == [(uuid(1), 1, GoalStatus.ABORTED)]
     assert goals.active() == []
+
+
+def test_cancelable_selects_without_changing_states() -> None:
+    goals = ActionGoals()
+    first = goals.accept(uuid(1), 10, "a")
+    goals.accept(uuid(2), 20, "b").update(GoalEvent.EXECUTE)
+    code, selected = goals.cancelable(ZERO_UUID, 0)
+    assert code is CancelCode.NONE and [g.uuid for g in selected] == [uuid(1), uuid(2)]
+    assert [g.status for g in goals.goals.values()] == [GoalStatus.ACCEPTED, GoalStatus.EXECUTING]
+    first.update(GoalEvent.EXECUTE)
+    first.update(GoalEvent.SUCCEED)
+    assert goals.cancelable(uuid(1), 0) == (CancelCode.GOAL_TERMINATED, [])
+    assert goals.cancelable(uuid(9), 0) == (CancelCode.UNKNOWN_GOAL_ID, [])
