@@ -5,6 +5,10 @@ artifacts, the topic graph and the metrics.
 Two ways in, both the real thing: ``server.runs.run.Run`` with the real sandbox launcher for
 scripts, and the ``robodojo run`` command line for launch files (as a student types it). Either
 way everything a check reads comes from the run's output folder, so one check serves both.
+
+A ROS 2 run's recording is read back with mcap-ros2-support, which decodes each CDR message
+from the ``ros2msg`` schema stored beside it (as ``ros2 bag play`` would), not with our own
+classes: a check on a ROS 2 recording is also a check that other tools can read it.
 """
 
 from __future__ import annotations
@@ -14,18 +18,22 @@ import math
 import struct
 import subprocess
 import sys
+from collections.abc import Callable
+from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
 
 from mcap.reader import make_reader
+from mcap_ros2.decoder import DecoderFactory
 
 from sandbox.msgs import get_message_class
 from sandbox.protocol import Clock
 from server.runs.run import Run
 from server.runs.spec import NodeSpec, RunSpec
 
-SCRIPTS = Path(__file__).parent / "scripts"
+SCRIPTS = Path(__file__).parent / "scripts"  # ROS 1 (rospy) scripts and launch files
+SCRIPTS_ROS2 = Path(__file__).parent / "scripts_ros2"  # ROS 2 (rclpy): a package's layout
 REPO = Path(__file__).parents[2]
 NS = 1_000_000_000
 WORLD_FRAME = "map"
@@ -67,15 +75,38 @@ class Outcome:
 
     @cached_property
     def recording(self) -> dict[str, list[tuple[float, object]]]:
-        """Topic (without its leading /) -> [(time [s], message)] in recording order."""
+        """Topic (without its leading /) -> [(time [s], message)] in recording order. ROS 1
+        messages are decoded by our classes, ROS 2 (CDR) ones by mcap-ros2-support from the
+        recorded schema."""
         topics: dict[str, list[tuple[float, object]]] = {}
+        ros2 = DecoderFactory()
+        decoders: dict[int, Callable[[bytes], object]] = {}
         with open(self.out_dir / "recording.mcap", "rb") as f:
             for schema, channel, message in make_reader(f).iter_messages():
-                decoded = get_message_class(schema.name).deserialize(message.data)
+                decode = decoders.get(channel.id)
+                if decode is None:
+                    decode = ros2.decoder_for(channel.message_encoding, schema)
+                    if decode is None:
+                        decode = get_message_class(schema.name).deserialize
+                    decoders[channel.id] = decode
                 topics.setdefault(channel.topic.lstrip("/"), []).append(
-                    (message.log_time / NS, decoded)
+                    (message.log_time / NS, decode(message.data))
                 )
         return topics
+
+    @cached_property
+    def recording_format(self) -> tuple[str, set[tuple[str, str]]]:
+        """The recording's profile and its (schema encoding, message encoding) pairs."""
+        with open(self.out_dir / "recording.mcap", "rb") as f:
+            reader = make_reader(f)
+            profile = reader.get_header().profile
+            summary = reader.get_summary()
+        assert summary is not None, "the recording has no summary section"
+        encodings = {
+            (summary.schemas[channel.schema_id].encoding, channel.message_encoding)
+            for channel in summary.channels.values()
+        }
+        return profile, encodings
 
     def messages(self, topic: str) -> list[tuple[float, object]]:
         return self.recording.get(topic.lstrip("/"), [])
@@ -169,9 +200,12 @@ def run_scripts(
     spawn: str | None = None,
     initial_pose: tuple[float, float, float] | None = None,
     files: tuple[str, ...] = (),
+    builtin_nodes: tuple[str, ...] = (),
     seed: int = 1,
+    scripts: Path = SCRIPTS,
 ) -> Outcome:
-    """Run the scripts unchanged as nodes of one run (server.runs.run.Run)."""
+    """Run the scripts of folder `scripts` unchanged as nodes of one run
+    (server.runs.run.Run)."""
     specs = []
     for node in nodes:
         # Only what a case uses is passed, so a case without parameters or remappings runs on
@@ -183,7 +217,7 @@ def run_scripts(
             extra["remaps"] = node.remaps
         if node.args:
             extra["args"] = node.args
-        path = SCRIPTS / node.file
+        path = scripts / node.file
         specs.append(
             NodeSpec(
                 name=node.node_name,
@@ -194,7 +228,9 @@ def run_scripts(
         )
     options: dict[str, object] = {}
     if files:
-        options["files"] = tuple((name, (SCRIPTS / name).read_bytes()) for name in files)
+        options["files"] = tuple((name, (scripts / name).read_bytes()) for name in files)
+    if builtin_nodes:
+        options["builtin_nodes"] = builtin_nodes
     spec = RunSpec(
         robot=robot,
         world=world,
@@ -221,8 +257,10 @@ def run_launch_file(
     duration_s: float,
     spawn: str | None = None,
     seed: int = 1,
+    scripts: Path = SCRIPTS,
 ) -> Outcome:
-    """Run a launch file as a student would: `robodojo run --launch FILE [name:=value ...]`."""
+    """Run a launch file of folder `scripts` as a student would:
+    `robodojo run --launch FILE [name:=value ...]`."""
     command = [
         sys.executable,
         "-m",
@@ -233,7 +271,7 @@ def run_launch_file(
         "--world",
         world,
         "--launch",
-        str(SCRIPTS / launch),
+        str(scripts / launch),
         *launch_args,
         "--clock",
         clock.value,
@@ -259,3 +297,68 @@ def run_launch_file(
             f"{done.stderr[-1500:]}"
         ) from None
     return Outcome(summary["state"], summary["reason"], out_dir, clock)
+
+
+# ------------------------------------------------------------------------------------- cases
+@dataclass(frozen=True)
+class Case:
+    """One corpus run: its scripts (or launch file), where it runs and what it must do."""
+
+    id: str
+    robot: str
+    world: str
+    duration_s: float
+    check: Callable[[Outcome], None]
+    nodes: tuple[Node, ...] = ()
+    launch: str | None = None  # relative to `scripts`
+    launch_args: tuple[str, ...] = ()  # name:=value, as roslaunch and ros2 launch take them
+    spawn: str | None = None
+    initial_pose: tuple[float, float, float] | None = None  # x [m], y [m], yaw [rad]
+    files: tuple[str, ...] = ()  # workspace data files the scripts read
+    builtin_nodes: tuple[str, ...] = ()  # the run's trusted helpers (map_server, ...)
+    clocks: tuple[Clock, ...] = (Clock.LOCKSTEP, Clock.REALTIME)
+    needs: tuple[str, ...] = ()  # features not on main yet: strict xfail on both clocks
+    realtime_needs: tuple[str, ...] = ()  # ... on the realtime clock only
+    scripts: Path = SCRIPTS  # the folder the scripts come from (the workspace)
+
+
+def run_case(case: Case, clock: Clock, launcher, out_dir: Path) -> Outcome:
+    if case.launch:
+        return run_launch_file(
+            out_dir,
+            launch=case.launch,
+            launch_args=case.launch_args,
+            robot=case.robot,
+            world=case.world,
+            clock=clock,
+            duration_s=case.duration_s,
+            spawn=case.spawn,
+            scripts=case.scripts,
+        )
+    return run_scripts(
+        launcher,
+        out_dir,
+        robot=case.robot,
+        world=case.world,
+        nodes=case.nodes,
+        clock=clock,
+        duration_s=case.duration_s,
+        spawn=case.spawn,
+        initial_pose=case.initial_pose,
+        files=case.files,
+        builtin_nodes=case.builtin_nodes,
+        scripts=case.scripts,
+    )
+
+
+def start_realtime_runs(
+    cases: list[Case], launcher, out_dir: Callable[[str], Path], at_once: int
+) -> tuple[ThreadPoolExecutor, dict[str, Future[Outcome]]]:
+    """Start the realtime runs of `cases`, `at_once` at a time: a realtime run takes its
+    duration in wall time, mostly waiting, so they overlap while each test waits for its own."""
+    pool = ThreadPoolExecutor(max_workers=at_once, thread_name_prefix="corpus")
+    futures = {
+        case.id: pool.submit(run_case, case, Clock.REALTIME, launcher, out_dir(case.id))
+        for case in cases
+    }
+    return pool, futures

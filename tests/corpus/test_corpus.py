@@ -9,9 +9,6 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Callable
-from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass
 
 import pytest
 
@@ -47,7 +44,14 @@ from tests.corpus.checks import (
     check_waypoints,
     check_yaml_config,
 )
-from tests.corpus.harness import SCRIPTS, Node, Outcome, run_launch_file, run_scripts
+from tests.corpus.harness import (
+    SCRIPTS,
+    Case,
+    Node,
+    run_case,
+    run_scripts,
+    start_realtime_runs,
+)
 
 # Realtime runs wait on the wall clock most of the time; this many share the machine at once.
 REALTIME_RUNS_AT_ONCE = 3
@@ -55,26 +59,6 @@ FINISHED = ("finished: duration reached", "finished: every node ended")
 
 
 # ------------------------------------------------------------------------------------- cases
-@dataclass(frozen=True)
-class Case:
-    """One corpus run: its scripts (or launch file), where it runs and what it must do."""
-
-    id: str
-    robot: str
-    world: str
-    duration_s: float
-    check: Callable[[Outcome], None]
-    nodes: tuple[Node, ...] = ()
-    launch: str | None = None
-    launch_args: tuple[str, ...] = ()  # name:=value, as roslaunch takes them
-    spawn: str | None = None
-    initial_pose: tuple[float, float, float] | None = None  # x [m], y [m], yaw [rad]
-    files: tuple[str, ...] = ()  # workspace data files the scripts read
-    clocks: tuple[Clock, ...] = (Clock.LOCKSTEP, Clock.REALTIME)
-    needs: tuple[str, ...] = ()  # features not on main yet: strict xfail on both clocks
-    realtime_needs: tuple[str, ...] = ()  # ... on the realtime clock only
-
-
 CASES = (
     Case(
         "talker_listener",
@@ -338,32 +322,6 @@ def _params():
             yield pytest.param(case, clock, id=f"{case.id}-{clock.value}", marks=marks)
 
 
-def run_case(case: Case, clock: Clock, launcher, out_dir) -> Outcome:
-    if case.launch:
-        return run_launch_file(
-            out_dir,
-            launch=case.launch,
-            launch_args=case.launch_args,
-            robot=case.robot,
-            world=case.world,
-            clock=clock,
-            duration_s=case.duration_s,
-            spawn=case.spawn,
-        )
-    return run_scripts(
-        launcher,
-        out_dir,
-        robot=case.robot,
-        world=case.world,
-        nodes=case.nodes,
-        clock=clock,
-        duration_s=case.duration_s,
-        spawn=case.spawn,
-        initial_pose=case.initial_pose,
-        files=case.files,
-    )
-
-
 @pytest.fixture(scope="module")
 def realtime_runs(request, launcher, tmp_path_factory):
     """A realtime run takes its duration in wall time, mostly waiting: the selected ones start
@@ -374,13 +332,12 @@ def realtime_runs(request, launcher, tmp_path_factory):
         if getattr(item, "originalname", None) == "test_course_script_runs_unchanged"
         and item.callspec.params["clock"] is Clock.REALTIME
     ]
-    pool = ThreadPoolExecutor(max_workers=REALTIME_RUNS_AT_ONCE, thread_name_prefix="corpus")
-    futures = {
-        case.id: pool.submit(
-            run_case, case, Clock.REALTIME, launcher, tmp_path_factory.mktemp(case.id) / "run"
-        )
-        for case in cases
-    }
+    pool, futures = start_realtime_runs(
+        cases,
+        launcher,
+        lambda case_id: tmp_path_factory.mktemp(case_id) / "run",
+        REALTIME_RUNS_AT_ONCE,
+    )
     yield futures
     pool.shutdown(wait=True, cancel_futures=True)
 
