@@ -90,6 +90,7 @@ def _build(msg_type: str) -> type[Message]:
 def get_message_class(msg_type: str) -> type[Message]:
     """The class of ``"pkg/Name"``, e.g. ``get_message_class("std_msgs/Int32")``.
 
+    A ROS 2 name (``"std_msgs/msg/Int32"``) gives the ROS 2 class from ``sandbox.msgs2``.
     Built on first use for the ROS types RoboDojo provides; raises UnknownMessageTypeError
     (a KeyError) with a sentence naming close matches for anything else.
     """
@@ -98,6 +99,10 @@ def get_message_class(msg_type: str) -> type[Message]:
         return cls
     if msg_type in MESSAGES:
         return _build(msg_type)
+    if msg_type.count("/") == 2 and msg_type.split("/")[1] in ("msg", "srv", "action"):
+        from sandbox.msgs2 import get_message_class as get_ros2_message_class
+
+        return get_ros2_message_class(msg_type)  # type: ignore[return-value]
     raise UnknownMessageTypeError(unknown_type_sentence(msg_type))
 
 
@@ -187,6 +192,10 @@ class Message(metaclass=_MessageMeta):
 
     _type: ClassVar[str]
     _definition: ClassVar[str]
+    # What a recorder writes for this class (MCAP's well-known encodings); ROS 2 classes say
+    # "ros2msg" and "cdr".
+    _schema_encoding: ClassVar[str] = "ros1msg"
+    _message_encoding: ClassVar[str] = "ros1"
     _md5sum: ClassVar[str]
     _full_text: ClassVar[str]
     _slot_types: ClassVar[list[str]]
