@@ -55,6 +55,19 @@ class BuiltinNode:
     subscribes: tuple[str, ...] = ()
     publishes: tuple[tuple[str, str], ...] = ()  # (topic, ROS type), told to student nodes
     rate_hz: float | None = None
+    # False: the node publishes and receives ROS 1 objects (sandbox.msgs) and the host converts
+    # them in a ROS 2 run. True: it speaks ROS 2 (sandbox.msgs2 objects, ROS 2 type names in
+    # `publishes` and graph_subscriptions()) and is left out of ROS 1 runs.
+    ros2_native = False
+
+    def graph_subscriptions(self) -> tuple[tuple[str, str], ...]:
+        """(topic, type) the node is listed as subscribing to in the run's graph, delivered
+        like `subscribes`. A service server needs its request topic here: a client's
+        wait_for_service looks for a subscriber of `__srv__/<service>`."""
+        return ()
+
+    def listens_to(self, topic: str) -> bool:
+        return topic in self.subscribes or any(t == topic for t, _ in self.graph_subscriptions())
 
     def start(self, run: Run) -> list[tuple[str, object]]:
         return []

@@ -1,14 +1,21 @@
 """How a run hosts its built-in nodes (server/runs/builtin.py): starts them once every student
 node has declared its subscriptions, ticks them at their rates, hands them the messages they
 subscribe to, and routes what they publish through the bus, the recording and - for command
-topics like teleop's Twist - to the robot."""
+topics like teleop's Twist - to the robot.
+
+Built-ins speak ROS 1 message objects (sandbox.msgs) unless they say `ros2_native = True`. In a
+ROS 2 run the host converts at the robot's edge (server/runs/dialect.py) for the ROS 1 ones: what
+they publish reaches the bus as ROS 2 CDR, what they receive arrives as ROS 1 objects. A ROS 2
+native built-in (the NavigateToPose server) publishes and receives sandbox.msgs2 objects as they
+are, and is left out of a ROS 1 run. `graph_subscriptions()` puts a built-in in the run's graph as
+a subscriber, which a service or action server needs: a client's wait_for_service looks there.
+"""
 
 from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from sandbox.msgs import get_message_class
-from sandbox.protocol import Envelope
+from sandbox.protocol import Envelope, TopicDecl
 from server.runs.builtin import BUILTIN_NODES, BuiltinNode
 
 if TYPE_CHECKING:
@@ -18,8 +25,12 @@ NS = 1_000_000_000
 
 
 class BuiltinHost:
-    def __init__(self, names: tuple[str, ...]) -> None:
-        self.nodes: list[BuiltinNode] = [BUILTIN_NODES[name]() for name in names]
+    def __init__(self, names: tuple[str, ...], ros_version: int = 1) -> None:
+        self.ros_version = ros_version
+        nodes = [BUILTIN_NODES[name]() for name in names]
+        self.nodes: list[BuiltinNode] = [
+            node for node in nodes if ros_version == 2 or not node.ros2_native
+        ]
         self._next_ns: dict[str, int] = {}
 
     def __bool__(self) -> bool:
@@ -28,13 +39,22 @@ class BuiltinHost:
     def get(self, name: str) -> BuiltinNode | None:
         return next((node for node in self.nodes if node.name == name), None)
 
-    def published_topics(self) -> list[tuple[str, str, float | None]]:
-        """(topic, ROS type, rate) of everything the built-ins publish, for the students."""
-        return [(t, kind, node.rate_hz) for node in self.nodes for t, kind in node.publishes]
+    def published_topics(self, run: Run) -> list[tuple[str, str, float | None]]:
+        """(topic, ROS type in the run's dialect, rate) of everything the built-ins publish,
+        for the students."""
+        return [
+            (topic, kind if node.ros2_native else run.dialect.type_name(kind), node.rate_hz)
+            for node in self.nodes
+            for topic, kind in node.publishes
+        ]
 
     def start(self, run: Run) -> None:
         for node in self.nodes:
             run.bus.add_node(node.name)
+            subscriptions = [TopicDecl(topic, kind) for topic, kind in node.graph_subscriptions()]
+            if subscriptions:
+                run.bus.declare(node.name, [], subscriptions)
+                run.bus.deliver_directly(node.name)
             # start() publishes the time-0 message; ticks follow one period later.
             self._next_ns[node.name] = round(NS / node.rate_hz) if node.rate_hz else 0
         # Every built-in is ready before any publishes (the planner needs its map before the
@@ -44,24 +64,40 @@ class BuiltinHost:
             self.publish(run, node, published)
 
     def publish(self, run: Run, node: BuiltinNode, published: list[tuple[str, object]]) -> None:
+        dialect = run.dialect
         for topic, message in published:
-            envelope = Envelope(topic, message._type, message.serialize())
+            if node.ros2_native:
+                envelope = Envelope(topic, message._type, message.serialize())
+            else:
+                envelope = dialect.envelope(topic, message)
             run.bus.publish(node.name, envelope, run.time_s)
             run.record(topic, envelope.type, run.time_ns, envelope.data)
             if topic in run.sim.robot.commands and not run.faults.motors_stalled():
-                run.sim.apply(topic, message)  # trusted: a rejection is our bug, let it raise
-            self.deliver(run, node.name, topic, message)
+                ros1 = dialect.to_ros1(message) if node.ros2_native else message
+                run.sim.apply(topic, ros1)  # trusted: a rejection is our bug, let it raise
+            self.deliver(run, node.name, topic, message, node.ros2_native)
 
-    def deliver(self, run: Run, source: str, topic: str, message: object) -> None:
+    def deliver(
+        self, run: Run, source: str, topic: str, message: object, native: bool = False
+    ) -> None:
+        """Hand `message` (a ROS 2 object if `native`, else ROS 1) to every built-in that
+        listens to `topic`, converted to the dialect each speaks."""
         for node in self.nodes:
-            if topic in node.subscribes and node.name != source:
-                self.publish(run, node, node.on_message(run, topic, message))
+            if node.name == source or not node.listens_to(topic):
+                continue
+            if node.ros2_native == native:
+                mine = message
+            elif node.ros2_native:
+                mine = run.dialect.to_ros2(message)
+            else:
+                mine = run.dialect.to_ros1(message)
+            self.publish(run, node, node.on_message(run, topic, mine))
 
     def deliver_envelope(self, run: Run, source: str, envelope: Envelope) -> None:
         """A student node's message, decoded only if a built-in listens to its topic."""
-        if any(envelope.topic in node.subscribes for node in self.nodes):
-            message = get_message_class(envelope.type).deserialize(envelope.data)
-            self.deliver(run, source, envelope.topic, message)
+        if any(node.listens_to(envelope.topic) for node in self.nodes):
+            message = run.dialect.decode(envelope)
+            self.deliver(run, source, envelope.topic, message, run.dialect.ros2)
 
     def tick(self, run: Run) -> None:
         for node in self.nodes:

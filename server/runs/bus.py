@@ -28,6 +28,10 @@ class _Topic:
     recent: deque = field(default_factory=lambda: deque(maxlen=RATE_WINDOW))
     latched_by: set[str] = field(default_factory=set)  # publishers with latch=True
     latched: dict[str, tuple[float, Envelope]] = field(default_factory=dict)  # their last
+    # A topic open to several types (a ROS 2 robot's velocity topic takes Twist and
+    # TwistStamped): each subscriber gets only messages of the type it subscribed with.
+    mixed: bool = False
+    subscriber_types: dict[str, str] = field(default_factory=dict)
 
     def rate_hz(self) -> float | None:
         if len(self.recent) < 2 or self.recent[-1] <= self.recent[0]:
@@ -54,6 +58,8 @@ class TopicBus:
         self._seq = 0
         self.version = 0  # bumped whenever a node, a publisher or a subscriber comes or goes
         self._ended: set[str] = set()  # nodes that ended: not routed to, not in graph_topics
+        # Subscribers the run hands messages to itself (built-in nodes): in the graph, no inbox.
+        self._direct: set[str] = set()
 
     # ----------------------------------------------------------------------------- graph
     def add_node(self, name: str) -> None:
@@ -66,11 +72,25 @@ class TopicBus:
         if topic is None:
             topic = self.topics[name] = _Topic(type_name)
             self.version += 1
-        elif topic.type != type_name:
+        elif topic.type != type_name and not topic.mixed:
             raise TopicTypeMismatch(f"topic '{name}' carries {topic.type}, not {type_name}")
         if publisher is not None and publisher not in topic.publishers:
             topic.publishers.add(publisher)
             self.version += 1
+
+    def allow_types(self, name: str, type_name: str) -> None:
+        """Declare `name` with `type_name` as the type it is listed with, and let publishers
+        use other types on it too (the robot's edge checks what reaches the robot)."""
+        self.declare_topic(name, type_name)
+        self.topics[name].mixed = True
+
+    def deliver_directly(self, node: str) -> None:
+        """`node` (a built-in) is listed as a subscriber but gets its messages from the run
+        directly, so nothing is queued for it."""
+        self._direct.add(node)
+        inbox = self._inboxes[node]
+        inbox.queues.clear()
+        inbox.pending = 0
 
     def declare(self, node: str, advertised: list[TopicDecl], subscribed: list[TopicDecl]) -> None:
         """Record what a node said it publishes and subscribes to (from its Yield)."""
@@ -82,11 +102,13 @@ class TopicBus:
             self.declare_topic(decl.name, decl.type)
             topic = self.topics[decl.name]
             topic.subscribers.add(node)
+            if topic.mixed:
+                topic.subscriber_types[node] = decl.type
             queue = self._inboxes[node].queues.setdefault(decl.name, deque(maxlen=QUEUE_SIZE))
             self.version += 1
             # A latched topic's last message reaches a subscriber that comes late (rospy).
             for publisher, (time_s, envelope) in sorted(topic.latched.items()):
-                if publisher != node:
+                if publisher != node and (not topic.mixed or envelope.type == decl.type):
                     self._enqueue(self._inboxes[node], queue, time_s, envelope)
 
     def unsubscribe(self, node: str, names: list[str]) -> None:
@@ -138,7 +160,7 @@ class TopicBus:
         if topic is None:
             self.declare_topic(envelope.topic, envelope.type, publisher)
             topic = self.topics[envelope.topic]
-        elif topic.type != envelope.type:
+        elif topic.type != envelope.type and not topic.mixed:
             raise TopicTypeMismatch(
                 f"topic '{envelope.topic}' carries {topic.type}, not {envelope.type}"
             )
@@ -151,7 +173,9 @@ class TopicBus:
         topic.recent.append(time_s)
         self._seq += 1
         for name in topic.subscribers:
-            if name == publisher or name in self._ended:
+            if name == publisher or name in self._ended or name in self._direct:
+                continue
+            if topic.mixed and topic.subscriber_types.get(name, envelope.type) != envelope.type:
                 continue
             inbox = self._inboxes[name]
             self._enqueue(inbox, inbox.queues[envelope.topic], time_s, envelope, self._seq)

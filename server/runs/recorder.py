@@ -8,10 +8,14 @@ Layout of ``out_dir``::
     artifacts/<node>/<name>      files a node saved
     <name>.json                  write_json("metrics", ...) -> metrics.json
 
-The MCAP file uses the ``ros1`` profile: each schema has encoding ``ros1msg``, the type name as
-its name and genmsg's full concatenated definition as its data, and each channel has message
-encoding ``ros1``, so Foxglove decodes the messages without knowing our types. A metadata record
-named ``run`` carries the run id and whatever run information the caller passes.
+The MCAP file of a ROS 1 run uses the ``ros1`` profile: each schema has encoding ``ros1msg``, the
+type name as its name and genmsg's full concatenated definition as its data, and each channel has
+message encoding ``ros1``, so Foxglove decodes the messages without knowing our types. A ROS 2
+run's (``profile="ros2"``) is what ``ros2 bag record`` writes with the MCAP storage plugin:
+``ros2msg`` schemas, ``cdr`` channels with rosbag2's channel metadata, a ``rosbag2`` metadata
+record and ``metadata.yaml`` beside it; internal service topics stay out (server/runs/rosbag2.py
+says why). A metadata record named ``run`` carries the run id and whatever run information the
+caller passes.
 
 Off the hot path: ``record()`` appends a tuple to an in-memory list under a lock and returns
 (about a microsecond); a writer thread swaps the list out in batches and writes it (schemas,
@@ -53,6 +57,8 @@ from typing import IO, Any
 from mcap.writer import CompressionType, Writer
 
 from sandbox.msgs import Message, get_message_class
+from sandbox.services import is_internal
+from server.runs import rosbag2
 from server.runs.safe_paths import inside, safe_name, safe_relative_path
 
 log = logging.getLogger(__name__)
@@ -125,7 +131,10 @@ class Recorder:
         metadata: Mapping[str, str] | None = None,
         max_buffer_bytes: int = DEFAULT_MAX_BUFFER_BYTES,
         compression: CompressionType | None = None,
+        profile: str = "ros1",
     ) -> None:
+        if profile not in ("ros1", "ros2"):
+            raise ValueError(f"profile must be 'ros1' or 'ros2', got {profile!r}")
         if not isinstance(max_buffer_bytes, int) or max_buffer_bytes <= 0:
             raise ValueError(f"max_buffer_bytes must be a positive int, got {max_buffer_bytes!r}")
         run_metadata = {"run_id": str(run_id)}
@@ -135,26 +144,32 @@ class Recorder:
             run_metadata[key] = value
         self.out_dir = Path(out_dir)
         self.run_id = str(run_id)
+        self.profile = profile
+        self._ros2 = profile == "ros2"
         self.recording_path = self.out_dir / RECORDING_FILE
         self.max_buffer_bytes = max_buffer_bytes
         self._wake_bytes = min(_WRITER_WAKE_BYTES, max(1, max_buffer_bytes // 2))
         self._lock = threading.Lock()
         self._changed = threading.Condition(self._lock)
         # Shared with the writer thread, guarded by _lock.
-        self._buffer: list[tuple[str, int, bytes]] = []
+        self._buffer: list[tuple[tuple[str, str], int, bytes]] = []  # ((topic, type), t, data)
         self._buffered_bytes = 0
-        self._pending_topics: list[tuple[str, type[Message]]] = []
+        self._pending_topics: list[tuple[str, str, type[Message]]] = []
         self._pending_logs: dict[str, list[str]] = {}
         self._accepting = True
         self._state = RecorderState.RECORDING
         self.error: str | None = None
         # Caller side.
-        self._topic_types: dict[str, str] = {}
+        self._topic_types: dict[str, str] = {}  # topic -> its first type
+        self._known: set[tuple[str, str]] = set()  # (topic, type) declared
         self._paths: dict[str, str] = {}
         self._closed_paths: dict[str, str] | None = None
         # Writer side.
-        self._channels: dict[str, int] = {}
-        self._channels_by_mcap_topic: dict[str, int] = {}
+        self._channels: dict[tuple[str, str], int] = {}
+        self._channels_by_mcap_topic: dict[tuple[str, str], int] = {}
+        self._channel_counts: dict[int, int] = {}  # channel id -> messages written
+        self._channel_topics: list[tuple[int, str, str]] = []  # (id, MCAP topic, type)
+        self._time_range: list[int] = []  # [first, last] log time written [ns]
         self._schemas: dict[str, int] = {}
         self._log_files: dict[str, IO[str]] = {}
         self._file: IO[bytes] | None = None
@@ -165,7 +180,7 @@ class Recorder:
             self.out_dir.mkdir(parents=True, exist_ok=True)
             self._file = open(self.recording_path, "wb")  # noqa: SIM115  # closed by the writer
             self._writer = Writer(self._file, compression=compression or _default_compression())
-            self._writer.start(profile="ros1")
+            self._writer.start(profile=profile)
             self._writer.add_metadata("run", run_metadata)
         except Exception as error:  # a recorder never raises a write error
             self._fail(error)
@@ -214,7 +229,8 @@ class Recorder:
     def add_topic(self, name: str, type_name: str) -> None:
         """Declare a topic so its channel exists even before (or without) a message.
 
-        Idempotent; a second type on the same topic is refused, as ROS refuses it."""
+        Idempotent; a second type on the same topic is refused, as ROS 1 refuses it (a ROS 2
+        recording gives it a channel of its own: ROS 2 lets a topic carry several types)."""
         if not isinstance(name, str) or not name.strip("/"):
             raise ValueError(f"topic name must be a non-empty string, got {name!r}")
         cls = get_message_class(type_name)  # unknown type: a sentence listing the known ones
@@ -223,14 +239,15 @@ class Recorder:
         topic = mcap_topic(name)
         with self._lock:
             for known_name, known_type in self._topic_types.items():
-                if mcap_topic(known_name) == topic and known_type != type_name:
+                if mcap_topic(known_name) == topic and known_type != type_name and not self._ros2:
                     raise ValueError(
                         f"topic '{topic}' is recorded as {known_type}; it cannot carry "
                         f"{type_name} too (use another topic name)"
                     )
-            if name not in self._topic_types:
-                self._topic_types[name] = type_name
-                self._pending_topics.append((name, cls))
+            if (name, type_name) not in self._known:
+                self._topic_types.setdefault(name, type_name)
+                self._known.add((name, type_name))
+                self._pending_topics.append((name, type_name, cls))
 
     # ----------------------------------------------------------------------------- hot path
     def record(self, topic: str, type_name: str, log_time_ns: int, data: bytes) -> None:
@@ -240,7 +257,10 @@ class Recorder:
         once the recorder has failed."""
         if self._state is RecorderState.FAILED:
             return
-        if self._topic_types.get(topic) != type_name:
+        key = (topic, type_name)
+        if key not in self._known:
+            if self._ros2 and is_internal(topic):
+                return  # hidden in ROS 2 and unknown to its tools (server/runs/rosbag2.py)
             self.add_topic(topic, type_name)
         if type(data) is not bytes:
             raise TypeError(f"record() needs the serialized bytes, got {type(data).__name__}")
@@ -254,7 +274,7 @@ class Recorder:
                 self._wait_for_room(size)
                 if not self._accepting:
                     return  # failed or closed while we waited
-            self._buffer.append((topic, log_time_ns, data))
+            self._buffer.append((key, log_time_ns, data))
             self._buffered_bytes += size
             if self._buffered_bytes >= self._wake_bytes:
                 self._changed.notify_all()
@@ -387,46 +407,60 @@ class Recorder:
                 if last_pass:
                     break
             assert self._writer is not None
+            if self._ros2:
+                self._write_rosbag2_metadata()
             self._writer.finish()
         except Exception as error:  # contained: the run goes on without us
             self._fail(error)
         finally:
             self._close_files()
 
-    def _write_topics(self, topics: list[tuple[str, type[Message]]]) -> None:
+    def _write_topics(self, topics: list[tuple[str, str, type[Message]]]) -> None:
         writer = self._writer
         assert writer is not None
-        for name, cls in topics:
+        for name, type_name, cls in topics:
             topic = mcap_topic(name)
-            channel_id = self._channels_by_mcap_topic.get(topic)
+            channel_id = self._channels_by_mcap_topic.get((topic, cls._type))
             if channel_id is None:
                 schema_id = self._schemas.get(cls._type)
                 if schema_id is None:
                     schema_id = writer.register_schema(
-                        name=cls._type, encoding="ros1msg", data=cls._full_text.encode()
+                        name=cls._type,
+                        encoding="ros2msg" if self._ros2 else "ros1msg",
+                        data=cls._full_text.encode(),
                     )
                     self._schemas[cls._type] = schema_id
                 channel_id = writer.register_channel(
                     topic=topic,
-                    message_encoding="ros1",
+                    message_encoding="cdr" if self._ros2 else "ros1",
                     schema_id=schema_id,
-                    metadata={"md5sum": cls._md5sum},
+                    metadata=rosbag2.channel_metadata(topic)
+                    if self._ros2
+                    else {"md5sum": cls._md5sum},
                 )
-                self._channels_by_mcap_topic[topic] = channel_id
-            self._channels[name] = channel_id
+                self._channels_by_mcap_topic[(topic, cls._type)] = channel_id
+                self._channel_topics.append((channel_id, topic, cls._type))
+            self._channels[(name, type_name)] = channel_id
 
     def _write_batch(self, batch: list[tuple[str, int, bytes]]) -> None:
         """Write queued messages in the order they were recorded (overridable in tests)."""
         writer = self._writer
         assert writer is not None
         channels = self._channels
-        for topic, log_time_ns, data in batch:
+        for key, log_time_ns, data in batch:
             writer.add_message(
-                channel_id=channels[topic],
+                channel_id=channels[key],
                 log_time=log_time_ns,
                 publish_time=log_time_ns,
                 data=data,
             )
+        if batch and self._ros2:  # counted for the rosbag2 metadata
+            counts = self._channel_counts
+            for key, _, _ in batch:
+                channel_id = channels[key]
+                counts[channel_id] = counts.get(channel_id, 0) + 1
+            times = [log_time_ns for _, log_time_ns, _ in batch] + self._time_range
+            self._time_range = [min(times), max(times)]
         if batch:
             assert self._file is not None
             now = time.monotonic()
@@ -437,6 +471,20 @@ class Recorder:
                 writer.flush()
                 self._last_chunk_flush = now
             self._file.flush()
+
+    def _write_rosbag2_metadata(self) -> None:
+        """The bag's metadata, in the MCAP file and as metadata.yaml (server/runs/rosbag2.py)."""
+        assert self._writer is not None
+        start_ns, end_ns = self._time_range or [0, 0]
+        topics = [
+            (topic, type_name, self._channel_counts.get(channel_id, 0))
+            for channel_id, topic, type_name in self._channel_topics
+        ]
+        metadata = rosbag2.bag_metadata(RECORDING_FILE, topics, start_ns, end_ns)
+        self._writer.add_metadata(
+            rosbag2.METADATA_RECORD, {"serialized_metadata": rosbag2.serialized(metadata)}
+        )
+        self._paths["metadata"] = str(rosbag2.write_metadata_yaml(self.out_dir, metadata))
 
     def _write_logs(self, logs: dict[str, list[str]]) -> None:
         if not logs:

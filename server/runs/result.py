@@ -19,12 +19,14 @@ class RunResult:
     nodes: dict[str, dict]
     paths: dict[str, str]
     graph: dict
+    ros_version: int = 1  # the run's ROS: 1 (rospy, step API) or 2 (rclpy)
 
     def summary(self) -> dict:
         """The result in one JSON-able dict, without histograms (metrics.json has them)."""
         return {
             "run_id": self.run_id,
             "state": str(self.state),
+            "ros_version": self.ros_version,
             "reason": self.reason,
             "duration_s": round(self.duration_s, 6),
             "wall_s": round(self.wall_s, 3),

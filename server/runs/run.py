@@ -23,7 +23,7 @@ from pathlib import Path
 
 import sandbox.services  # noqa: F401  # registers the service envelope types the recorder sees
 from sandbox.launcher import Launcher
-from sandbox.msgs import Time, get_message_class
+from sandbox.msgs import Time
 from sandbox.msgs.geometry_msgs import Point, Pose, PoseStamped, Quaternion
 from sandbox.msgs.std_msgs import Header
 from sandbox.msgs.tf2_msgs import TFMessage
@@ -42,6 +42,7 @@ from sandbox.protocol import (
 from server.runs.builtin_host import BuiltinHost
 from server.runs.bus import ROBOT, RUN, TopicBus
 from server.runs.controls import RunControls
+from server.runs.dialect import Dialect
 from server.runs.faults import Faults
 from server.runs.metrics import NodeMetrics
 from server.runs.outputs import RunObserver, RunOutputs
@@ -105,6 +106,7 @@ class Run(RunControls, RunOutputs):
         self.backend = backend  # a real robot (server/hardware/backend.py), else simulated
         self.observer = observer
         self.spec = spec
+        self.dialect = Dialect(spec.ros_version)  # the robot's edge in the run's ROS dialect
         self.launcher = launcher
         self.run_id = run_id or uuid.uuid4().hex[:12]
         self.out_dir = Path(out_dir)
@@ -122,7 +124,7 @@ class Run(RunControls, RunOutputs):
         self._next_tf_ns = 0
         self.clock_wall_s = 0.0  # wall time the clock ran (node start-up excluded)
         self._script = sorted(spec.script, key=lambda event: event[0])
-        self.builtins = BuiltinHost(spec.builtin_nodes)
+        self.builtins = BuiltinHost(spec.builtin_nodes, self.dialect.ros_version)
 
     # ----------------------------------------------------------------------------- lifecycle
     def _move(self, new: RunState) -> None:
@@ -163,10 +165,13 @@ class Run(RunControls, RunOutputs):
         spawn = Pose2D(*spec.initial_pose) if spec.initial_pose else spec.spawn
         self.sim = self.backend or Simulation(spec.robot, spec.world, seed=spec.seed, spawn=spawn)
         self.out_dir.mkdir(parents=True, exist_ok=True)
+        dialect = self.dialect
         self.recorder = Recorder(
             self.out_dir,
             self.run_id,
+            profile="ros2" if dialect.ros2 else "ros1",
             metadata={
+                "ros_version": str(dialect.ros_version),
                 "robot": spec.robot,
                 "world": spec.world,
                 "clock": str(spec.clock),
@@ -176,12 +181,15 @@ class Run(RunControls, RunOutputs):
             },
         )
         for topic in self.sim.topics:
-            self.bus.declare_topic(topic.name, topic.type_name, ROBOT if topic.rate_hz else None)
-            self.recorder.add_topic(topic.name, topic.type_name)
-        self.bus.declare_topic(GOAL_TOPIC, PoseStamped._type, RUN)
-        self.recorder.add_topic(GOAL_TOPIC, PoseStamped._type)
-        self.bus.declare_topic(TF_TOPIC, TFMessage._type, RUN)
-        self.recorder.add_topic(TF_TOPIC, TFMessage._type)
+            type_name = dialect.type_name(topic.type_name)
+            if len(dialect.accepted_types(topic.type_name)) > 1:  # Twist or TwistStamped
+                self.bus.allow_types(topic.name, type_name)  # recorded in the type sent
+                continue
+            self.bus.declare_topic(topic.name, type_name, ROBOT if topic.rate_hz else None)
+            self.recorder.add_topic(topic.name, type_name)
+        for name, ros1_type in ((GOAL_TOPIC, PoseStamped._type), (TF_TOPIC, TFMessage._type)):
+            self.bus.declare_topic(name, dialect.type_name(ros1_type), RUN)
+            self.recorder.add_topic(name, dialect.type_name(ros1_type))
         if spec.light_position is not None:
             movable = [light.name for light in self.sim.lights if light.movable]
             if movable:
@@ -193,12 +201,14 @@ class Run(RunControls, RunOutputs):
 
     def _node_info(self, node: NodeSpec) -> NodeInfo:
         topics = [
-            RobotTopic(t.name, t.type_name, str(t.direction), t.rate_hz) for t in self.sim.topics
+            RobotTopic(t.name, self.dialect.type_name(t.type_name), str(t.direction), t.rate_hz)
+            for t in self.sim.topics
         ]
-        topics.append(RobotTopic(GOAL_TOPIC, PoseStamped._type, "publish", None))
+        goal_type = self.dialect.type_name(PoseStamped._type)
+        topics.append(RobotTopic(GOAL_TOPIC, goal_type, "publish", None))
         topics.extend(
             RobotTopic(topic, kind, "publish", rate)
-            for topic, kind, rate in self.builtins.published_topics()
+            for topic, kind, rate in self.builtins.published_topics(self)
         )
         velocity = self.velocity_topic
         return NodeInfo(
@@ -212,6 +222,7 @@ class Run(RunControls, RunOutputs):
             argv=list(node.args),
             remaps=dict(node.remaps),
             namespace=node.namespace,
+            ros_version=self.dialect.ros_version,
         )
 
     def _start_nodes(self) -> None:
@@ -273,6 +284,7 @@ class Run(RunControls, RunOutputs):
             nodes=metrics["nodes"],
             paths=paths,
             graph=self.bus.graph(),
+            ros_version=self.dialect.ros_version,
         )
 
     def _end_node(self, slot: NodeSlot, reason: str) -> None:
@@ -300,6 +312,7 @@ class Run(RunControls, RunOutputs):
             "distance_travelled_m": state.distance_travelled_m if state else 0.0,
             "time_out_of_bounds_s": state.time_out_of_bounds_s if state else 0.0,
             "clock_wall_s": self.clock_wall_s,
+            "ros_version": self.dialect.ros_version,
         }
         nodes = {}
         for slot in self.slots.values():
@@ -409,7 +422,13 @@ class Run(RunControls, RunOutputs):
         if self.faults.motors_stalled():
             return
         try:
-            message = get_message_class(envelope.type).deserialize(envelope.data)
+            ros1_type = self.sim.robot.commands[envelope.topic][0]._type
+            message = self.dialect.command(
+                slot.name, envelope, ros1_type, lambda line: self._log_lines(slot, [line])
+            )
+            if message is None:  # a type the topic does not take (said once in the log)
+                slot.metrics.rejected_commands += 1
+                return
             self.sim.apply(envelope.topic, message)
         except (SimulationError, CommandError, ValueError) as error:
             slot.metrics.rejected_commands += 1
@@ -419,7 +438,7 @@ class Run(RunControls, RunOutputs):
             slot.metrics.latency.add(self.time_ns / NS - slot.newest_sensor_s)
 
     def _from_robot(self, topic: str, message: object, time_s: float) -> None:
-        envelope = Envelope(topic, message._type, message.serialize())
+        envelope = self.dialect.envelope(topic, message)
         self.record(topic, envelope.type, round(time_s * NS), envelope.data)
         if self.faults.active:
             self.faults.expire(self.time_ns)
@@ -441,11 +460,11 @@ class Run(RunControls, RunOutputs):
         for name, (msg_type, _) in self.sim.robot.commands.items():
             if msg_type._type != "geometry_msgs/Twist":
                 continue
-            zero = msg_type()
             try:
                 if self.backend is None:  # a real robot was stopped above
-                    self.sim.apply(name, zero)
-                self.record(name, msg_type._type, self.time_ns, zero.serialize())
+                    self.sim.apply(name, msg_type())
+                zero_type, data = self.dialect.zero_command(name, msg_type, self.time_ns)
+                self.record(name, zero_type, self.time_ns, data)
             except Exception:  # the end must go on whatever the robot says
                 log.exception("run %s: could not command zero velocity on %s", self.run_id, name)
 
@@ -462,7 +481,7 @@ class Run(RunControls, RunOutputs):
                 orientation=Quaternion(z=math.sin(yaw / 2), w=math.cos(yaw / 2)),
             ),
         )
-        envelope = Envelope(GOAL_TOPIC, PoseStamped._type, goal.serialize())
+        envelope = self.dialect.envelope(GOAL_TOPIC, goal)
         self.bus.publish(RUN, envelope, self.time_ns / NS)
         self.record(GOAL_TOPIC, envelope.type, self.time_ns, envelope.data)
 
@@ -550,8 +569,8 @@ class Run(RunControls, RunOutputs):
             self.sim.robot.sensor_frames(self.sim.state),
             odom_origin=(origin.x, origin.y, origin.yaw),
         )
-        data = message.serialize()
-        self.record(TF_TOPIC, message._type, self.time_ns, data)
+        envelope = self.dialect.envelope(TF_TOPIC, message)
+        self.record(TF_TOPIC, envelope.type, self.time_ns, envelope.data)
         # Nodes see the same tree on "tf" (tf2_ros.TransformListener subscribes to it).
-        self.bus.publish(RUN, Envelope(TF_TOPIC, message._type, data), self.time_ns / NS)
+        self.bus.publish(RUN, envelope, self.time_ns / NS)
         self._next_tf_ns = self.time_ns + TF_PERIOD_NS

@@ -1,9 +1,18 @@
 """What a run is made of, checked before anything starts: a robot in a world, one or more nodes
 (a launch file's worth of student code), a clock, a duration, a seed and optional parameters.
-Every problem is a sentence a newcomer can act on."""
+Every problem is a sentence a newcomer can act on.
+
+A run is ROS 1 or ROS 2, never both (docs/architecture.md, "ROS 2"): each node's file says which
+by what it imports (`import rclpy` / `from rclpy... import`: ROS 2; rospy or the step API:
+ROS 1; a file importing neither goes with the others), read with `ast` so nothing runs. A node
+or the run may also say so explicitly (`NodeSpec.ros_version`, `RunSpec.explicit_ros_version`).
+No bridge: a run mixing the two is refused with a sentence naming one node of each.
+"""
 
 from __future__ import annotations
 
+import ast
+import functools
 import math
 import re
 from dataclasses import dataclass, field
@@ -39,6 +48,8 @@ class NodeSpec:
     remaps: tuple[tuple[str, str], ...] = ()  # (from, to) name pairs, as <remap from to>
     args: tuple[str, ...] = ()  # command-line arguments after the file name (rosrun style)
     namespace: str = "/"  # <group ns="..."> / <node ns="...">
+    # 1 (rospy) or 2 (rclpy); None: read from the code (a node of a Python launch file is 2).
+    ros_version: int | None = None
 
     @classmethod
     def from_file(cls, path: str | Path, name: str | None = None) -> NodeSpec:
@@ -73,6 +84,33 @@ class RunSpec:
     builtin_nodes: tuple[str, ...] = ()  # trusted helpers: map_server, localization, ...
     # Workspace data files (relative path, bytes) copied into every node's working directory.
     files: tuple[tuple[str, bytes], ...] = ()
+    explicit_ros_version: int | None = None  # 1 or 2; None: decided from the nodes
+
+    @property
+    def ros_version(self) -> int:
+        """1 or 2: the run's ROS (the explicit value, else what its nodes use, else 1).
+        Raises RunSpecError for a run that mixes the two."""
+        decided = [(node, *node_ros_version(node)) for node in self.nodes]
+        explicit = self.explicit_ros_version
+        if explicit is not None:
+            if explicit not in (1, 2):
+                raise RunSpecError(f"ros_version must be 1 or 2, got {explicit!r}")
+            for node, version, why in decided:
+                if version is not None and version != explicit:
+                    raise RunSpecError(
+                        f"node `{node.name}` {why} (ROS {version}) but this run is ROS "
+                        f"{explicit}; a run is one or the other"
+                    )
+            return explicit
+        ros2 = next(((n, why) for n, version, why in decided if version == 2), None)
+        ros1 = next(((n, why) for n, version, why in decided if version == 1), None)
+        if ros2 and ros1:
+            (node2, why2), (node1, why1) = ros2, ros1
+            raise RunSpecError(
+                f"node `{node2.name}` {why2} (ROS 2) and node `{node1.name}` {why1} (ROS 1); "
+                "a run is one or the other"
+            )
+        return 2 if ros2 else 1
 
     def validate(self) -> None:
         """Raise RunSpecError naming the first problem found."""
@@ -116,6 +154,7 @@ class RunSpec:
                 raise RunSpecError(
                     f"node '{node.name}' is larger than {MAX_CODE_BYTES // 1024} KiB of code"
                 )
+        self.ros_version  # noqa: B018  # a run mixing ROS 1 and ROS 2 nodes is refused here
         from server.runs.builtin import BUILTIN_NODES
 
         for name in self.builtin_nodes:
@@ -139,3 +178,41 @@ class RunSpec:
                 isinstance(v, (int, float)) and math.isfinite(v) for v in values
             ):
                 raise RunSpecError(f"{label} must be finite numbers, got {values!r}")
+
+
+def node_ros_version(node: NodeSpec) -> tuple[int | None, str]:
+    """(1, 2 or None for "either", and the words saying why: "uses rclpy") for one node."""
+    if node.ros_version is not None:
+        if node.ros_version not in (1, 2):
+            raise RunSpecError(
+                f"node `{node.name}`: ros_version must be 1 or 2, got {node.ros_version!r}"
+            )
+        return node.ros_version, f"is a ROS {node.ros_version} node"
+    if node.api is Api.STEP:
+        return 1, "uses the step API"
+    return _ros_version_of_code(node.code)
+
+
+@functools.lru_cache(maxsize=256)
+def _ros_version_of_code(code: str) -> tuple[int | None, str]:
+    """What a file's imports say (rclpy wins over rospy: a file trying one then the other is
+    written for ROS 2 first); a file that does not parse is left to its own error later."""
+    try:
+        tree = ast.parse(code)
+    except (SyntaxError, ValueError):
+        return None, ""
+    imported = set()
+    for item in ast.walk(tree):
+        if isinstance(item, ast.Import):
+            imported.update(alias.name.split(".")[0] for alias in item.names)
+        elif isinstance(item, ast.ImportFrom) and item.module and not item.level:
+            imported.add(item.module.split(".")[0])
+    if "rclpy" in imported:
+        return 2, "uses rclpy"
+    if "rospy" in imported:
+        return 1, "uses rospy"
+    defines_step = any(
+        isinstance(item, ast.FunctionDef | ast.AsyncFunctionDef) and item.name == "step"
+        for item in tree.body
+    )
+    return (1, "uses the step API") if defines_step else (None, "")

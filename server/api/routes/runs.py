@@ -52,6 +52,9 @@ def run_out(record: RunRecord, service: RunService, with_code: bool = False) -> 
         "robot": record.robot,
         "world": record.world,
         "clock": record.clock,
+        "ros_version": active.run.dialect.ros_version
+        if active
+        else (record.metrics or {}).get("ros_version", 1),
         "duration_s": record.duration_s,
         "seed": record.seed,
         "hardware": record.hardware,
