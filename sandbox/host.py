@@ -226,6 +226,10 @@ def _finish(
 
 def run_node(link: Link, load: Load, workdir: str, limits: Limits = DEFAULT_LIMITS) -> Exited:
     """Run the student's code to its end; return the Exited frame for the runner to send."""
+    if load.api is Api.LAUNCH:  # a launch file to read, not a node (sandbox/launch2/job.py)
+        from sandbox.launch2.job import run_launch
+
+        return run_launch(load, workdir)
     node = NodeRuntime(
         link, load.info, NodeClock(load.info.clock, load.info.start_time_s), load.filename
     )

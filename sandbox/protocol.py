@@ -43,6 +43,10 @@ class Api(StrEnum):
     AUTO = "auto"  # a file defining step() uses the step API, anything else runs as a script
     STEP = "step"
     ROSPY = "rospy"
+    # Not a node: a one-shot job that reads a ROS 2 Python launch file (Load.code, named
+    # Load.filename, with the workspace in Load.files and `name:=value` arguments in
+    # NodeInfo.argv) and ends with Exited carrying the plan (sandbox/launch2/job.py).
+    LAUNCH = "launch"
 
 
 class Outcome(StrEnum):

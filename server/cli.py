@@ -6,6 +6,9 @@
     robodojo run --robot turtlebot3 --world maze --node follower=wall.py --param speed=0.2 \
                  --remap scan:=base_scan --args "_gain:=1.5"   # rosrun-style, per node
     robodojo run --robot turtlebot3 --world maze --launch pkg/launch/two.launch speed:=0.3
+    robodojo run --robot crowbot --world wall_approach --launch pkg/launch/two.launch.py speed:=0.3
+    robodojo run --robot crowbot --world wall_approach --node talker.py \
+                 --args "--ros-args -p speed:=0.2 -r cmd_vel:=Control"   # a ROS 2 node's argv
     robodojo export RUN_DIR               # a CSV per topic from a run's recording
     robodojo serve                        # the web lab (server/api/serve.py)
 
@@ -36,7 +39,8 @@ from server.cli_nodes import (
     read_workspace,
     workspace_folder,
 )
-from server.runs.launch import load_launch
+from server.runs.launch import LaunchPlan
+from server.runs.launch_py import is_python_launch, read_launch
 from server.runs.run import Run
 from server.runs.spec import NodeSpec, RunSpec, RunSpecError
 from server.runs.state import RunState
@@ -108,11 +112,25 @@ def _nodes_and_files(args: argparse.Namespace) -> tuple[tuple[NodeSpec, ...], di
             f"launch file '{launch_file}' is not inside the workspace '{folder}'"
         ) from None
     workspace = read_workspace(folder)
-    plan = load_launch(relative, workspace, launch_arguments(launch_args))
+    plan = _read_plan(relative, workspace, launch_arguments(launch_args), args.unsafe_no_sandbox)
     _, run_params = nodes_from_flags(ordered)  # --param NAME=VALUE: run-wide, as before
     for note in plan.notes:
         print(f"robodojo: note: {note}", file=sys.stderr)
     return plan.nodes, {**plan.params, **run_params}, data_files(workspace)
+
+
+def _read_plan(
+    relative: str, workspace: dict[str, bytes], launch_args: dict[str, str], unsafe: bool
+) -> LaunchPlan:
+    """A ROS 1 launch file is read here; a ROS 2 Python launch file is student code, run in a
+    sandboxed launch job of its own (server/runs/launch_py.py)."""
+    if not is_python_launch(relative, workspace.get(relative)):
+        return read_launch(relative, workspace, launch_args, None)
+    launcher = Launcher(pool_size=0, unsafe_no_sandbox=unsafe)
+    try:
+        return read_launch(relative, workspace, launch_args, launcher)
+    finally:
+        launcher.close()
 
 
 class Progress:
@@ -292,7 +310,8 @@ def build_parser() -> argparse.ArgumentParser:
         nargs="+",
         default=None,
         metavar=("FILE", "NAME:=VALUE"),
-        help="a ROS 1 .launch file, then its arguments as roslaunch takes them",
+        help="a launch file (ROS 2 .launch.py or ROS 1 .launch), then its arguments as ros2 "
+        "launch and roslaunch take them (name:=value)",
     )
     run.add_argument(
         "--workspace",

@@ -70,6 +70,7 @@ class LaunchPlan:
     nodes: tuple[NodeSpec, ...]
     params: dict[str, object] = field(default_factory=dict)
     notes: tuple[str, ...] = ()
+    ros_version: int = 1  # 2 for a ROS 2 Python launch file (server/runs/launch_py.py)
 
 
 def load_launch(

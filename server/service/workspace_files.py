@@ -1,5 +1,6 @@
-"""What a workspace may hold: node code (`.py`) and the text data files a ROS package keeps next
-to it (CSV, YAML, JSON, TXT, `.launch` and `.xml`), by name, kind and size. Every refusal is a
+"""What a workspace may hold: node code (`.py`; `.launch.py` for a ROS 2 launch file) and the
+text data files a ROS package keeps next to it (CSV, YAML, JSON, TXT, `.launch` and `.xml`), by
+name, kind and size. Every refusal is a
 sentence that names the file and says what to do.
 
 Names are relative paths of at most three parts ("waypoints.csv", "config/gains.yaml",
@@ -15,6 +16,7 @@ from dataclasses import dataclass
 
 CODE_EXTENSION = ".py"
 DATA_EXTENSIONS = (".csv", ".yaml", ".yml", ".json", ".txt", ".launch", ".xml")
+LAUNCH_PY_SUFFIX = ".launch.py"  # a ROS 2 Python launch file: code, but never a node
 MAX_NAME_CHARS = 64  # the store's file name column
 MAX_PARTS = 3  # folder depth: a package's config/ or launch/ folder, not a tree
 _PART = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.\-]*$")
@@ -73,11 +75,12 @@ def file_name(name: str) -> str:
         raise WorkspaceFileError(f"'{name}' is longer than {MAX_NAME_CHARS} characters")
     extension = _extension(name)
     if extension == CODE_EXTENSION:
-        stem = name.rsplit("/", 1)[-1][: -len(CODE_EXTENSION)]
+        base = name.rsplit("/", 1)[-1]
+        stem = base[: -len(LAUNCH_PY_SUFFIX if is_launch_py(base) else CODE_EXTENSION)]
         if not _NODE_STEM.match(stem):
             raise WorkspaceFileError(
                 f"'{name}': a Python file's name is a node name: a letter, then letters, "
-                "digits or _ (at most 40), then .py"
+                "digits or _ (at most 40), then .py (or .launch.py for a ROS 2 launch file)"
             )
     elif extension not in DATA_EXTENSIONS:
         raise WorkspaceFileError(
@@ -91,9 +94,14 @@ def is_code(name: str) -> bool:
     return _extension(name) == CODE_EXTENSION
 
 
+def is_launch_py(name: str) -> bool:
+    return name.lower().endswith(LAUNCH_PY_SUFFIX)
+
+
 def is_node_file(name: str) -> bool:
-    """A .py file at the top of the workspace: a node of a run started from the page."""
-    return is_code(name) and "/" not in name
+    """A .py file at the top of the workspace (not a .launch.py): a node of a run started
+    from the page."""
+    return is_code(name) and "/" not in name and not is_launch_py(name)
 
 
 def check_content(name: str, text: str, caps: Caps) -> None:

@@ -13,14 +13,16 @@ from collections.abc import Mapping
 
 from sqlalchemy.orm import Session as Db
 
-from server.runs.launch import LaunchFileError, LaunchPlan, load_launch
+from sandbox.launcher import Launcher
+from server.runs.launch import LaunchFileError, LaunchPlan
+from server.runs.launch_py import is_python_launch, read_launch
 from server.service import exercises, workspace_files
 from server.service.catalog import UnknownIdError
 from server.service.runs import RunRequestError
 from server.sim import robot_ids
 from server.store import workspaces as store
 
-LAUNCH_EXTENSIONS = (".launch", ".xml")
+LAUNCH_EXTENSIONS = (".launch", ".xml", ".launch.py")  # ROS 1 XML; ROS 2 Python (sandboxed)
 log = logging.getLogger("robodojo.service")
 
 
@@ -46,14 +48,21 @@ def contents(db: Db, user_id: str, workspace: str) -> dict[str, str]:
     return files
 
 
-def launch_plan(files: Mapping[str, str], launch_file: str, args: Mapping[str, str]) -> LaunchPlan:
+def launch_plan(
+    files: Mapping[str, str],
+    launch_file: str,
+    args: Mapping[str, str],
+    launcher: Launcher | None,
+) -> LaunchPlan:
     """The nodes (with their params, remaps, args and namespaces), the global parameters and
     the reader's notes of a launch file of the workspace `files`; LaunchFileError (a 422 with
-    the reader's sentence, which names the file and the line) for anything wrong in it."""
+    the reader's sentence, which names the file and the line) for anything wrong in it. A ROS 2
+    Python launch file is evaluated in a sandboxed job of `launcher`, never in this process."""
     name = workspace_files.file_name(launch_file)
-    if not name.endswith(LAUNCH_EXTENSIONS):
+    if not (name.endswith(LAUNCH_EXTENSIONS) or is_python_launch(name, files.get(name))):
         raise RunRequestError(
-            f"'{launch_file}' is not a launch file; give a .launch (or .xml) file of the workspace"
+            f"'{launch_file}' is not a launch file; give a .launch.py (ROS 2) or .launch (ROS 1) "
+            "file of the workspace"
         )
     if name not in files:
         found = sorted(f for f in files if f.endswith(LAUNCH_EXTENSIONS))
@@ -62,7 +71,7 @@ def launch_plan(files: Mapping[str, str], launch_file: str, args: Mapping[str, s
             + (f"its launch files: {', '.join(found)}" if found else "it has no launch file yet")
         )
     try:
-        return load_launch(name, files, dict(args))
+        return read_launch(name, files, dict(args), launcher)
     except LaunchFileError:
         raise
     except Exception as error:  # a fault of the reader: the student still gets a sentence
@@ -72,6 +81,6 @@ def launch_plan(files: Mapping[str, str], launch_file: str, args: Mapping[str, s
             name,
             None,
             f"this launch file could not be read ({type(error).__name__}; incident {incident}, "
-            "logged): check that it is well-formed roslaunch XML, and tell your instructor the "
+            "logged): check that it is a well-formed launch file, and tell your instructor the "
             "incident number",
         ) from None

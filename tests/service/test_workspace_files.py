@@ -70,6 +70,14 @@ def test_bad_names_are_refused_with_a_sentence(name, words):
 def test_only_top_level_python_files_are_nodes():
     assert is_node_file("pid.py") and not is_node_file("scripts/pid.py")
     assert not is_node_file("two.launch") and not is_node_file("pid.csv")
+    assert not is_node_file("two.launch.py")  # a ROS 2 launch file is code, never a node
+
+
+def test_a_ros2_launch_file_keeps_its_name():
+    assert file_name("launch/two.launch.py") == "launch/two.launch.py"
+    assert file_name("bringup.launch.py") == "bringup.launch.py"
+    with pytest.raises(WorkspaceFileError, match=re.escape(".launch.py for a ROS 2 launch")):
+        file_name("2.launch.py")
 
 
 def test_sizes_are_capped_per_kind_and_binary_text_is_refused():
@@ -111,24 +119,24 @@ def test_a_run_copies_every_data_file_and_no_code():
 def test_a_launch_file_must_be_one_of_the_workspace():
     files = {"two.launch": "<launch/>", "pid.py": "x"}
     with pytest.raises(RunRequestError, match=re.escape("its launch files: two.launch")):
-        workspace_runs.launch_plan(files, "one.launch", {})
+        workspace_runs.launch_plan(files, "one.launch", {}, None)
     with pytest.raises(RunRequestError, match="not a launch file"):
-        workspace_runs.launch_plan(files, "pid.py", {})
+        workspace_runs.launch_plan(files, "pid.py", {}, None)
     with pytest.raises(RunRequestError, match="no launch file yet"):
-        workspace_runs.launch_plan({"pid.py": "x"}, "x.launch", {})
+        workspace_runs.launch_plan({"pid.py": "x"}, "x.launch", {}, None)
     with pytest.raises(WorkspaceFileError, match=re.escape("'..'")):
-        workspace_runs.launch_plan(files, "../two.launch", {})
+        workspace_runs.launch_plan(files, "../two.launch", {}, None)
 
 
 def test_a_fault_of_the_reader_is_a_sentence_with_an_incident_not_a_crash(monkeypatch, caplog):
     def broken(*_args):
         raise TypeError("'int' object is not iterable")
 
-    monkeypatch.setattr(workspace_runs, "load_launch", broken)
+    monkeypatch.setattr(workspace_runs, "read_launch", broken)
     expected = re.escape("could not be read (TypeError; incident")
     with (
         caplog.at_level(logging.ERROR, "robodojo.service"),
         pytest.raises(LaunchFileError, match=expected),
     ):
-        workspace_runs.launch_plan({"a.launch": "<launch/>"}, "a.launch", {})
+        workspace_runs.launch_plan({"a.launch": "<launch/>"}, "a.launch", {}, None)
     assert "the launch reader failed on a.launch" in caplog.text

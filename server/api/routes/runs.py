@@ -173,7 +173,9 @@ def _nodes_and_files(
             files = workspace_runs.contents(db, caller.id, workspace)
     plan = None
     if body.launch is not None:
-        plan = workspace_runs.launch_plan(files, body.launch.file, body.launch.args)
+        plan = workspace_runs.launch_plan(
+            files, body.launch.file, body.launch.args, service_of(request).launcher
+        )
         nodes = plan.nodes
     else:
         nodes = tuple(
