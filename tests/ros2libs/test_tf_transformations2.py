@@ -10,6 +10,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from sandbox.host import install_ros_compat
+from sandbox.msgs import get_message_class
 from tests.ros2libs.loading import load_ros2_package
 
 install_ros_compat()
@@ -72,10 +73,6 @@ def test_a_yaw_the_way_ros2_courses_build_and_read_it() -> None:
 
 
 def test_a_message_instead_of_a_list_gets_the_shared_sentence() -> None:
-    class FakeQuaternion:  # the attributes the check reads (msgs2's classes have them)
-        _type = "geometry_msgs/msg/Quaternion"
-        x = y = z = 0.0
-        w = 1.0
-
+    quaternion = get_message_class("geometry_msgs/msg/Quaternion")(w=1.0)
     with pytest.raises(TypeError, match=r"geometry_msgs/msg/Quaternion message.*\[q\.x, q\.y"):
-        ros2.euler_from_quaternion(FakeQuaternion())
+        ros2.euler_from_quaternion(quaternion)
