@@ -24,14 +24,26 @@ from sandbox.msgs._core import (
 
 from ._catalog import all_messages, unknown_type_sentence
 from ._core import BUILD_LOCK, Message, build, registered
+from ._services import (
+    Action,
+    Service,
+    UnknownServiceTypeError,
+    get_action_class,
+    get_service_class,
+)
 
 __all__ = [
     "MESSAGE_TYPES",
+    "Action",
     "DeserializationError",
     "Message",
     "SerializationError",
+    "Service",
     "UnknownMessageTypeError",
+    "UnknownServiceTypeError",
+    "get_action_class",
     "get_message_class",
+    "get_service_class",
 ]
 
 

@@ -90,10 +90,18 @@ def unknown_type_sentence(type_name: str, kind: str = MSG) -> str:
             f"unknown {noun} type {type_name!r}: RoboDojo has no ROS 2 package {package!r}; "
             f"the packages are {', '.join(packages())}"
         )
+    getter = {MSG: "get_message_class", SRV: "get_service_class", ACTION: "get_action_class"}
     for other in KINDS:
-        if name in names(package, other) and other != written_kind:
-            article = "an" if other == ACTION else "a"
-            return f"{package}/{other}/{name} is {article} {other}, not a {noun}"
+        if name in names(package, other) and other != kind:
+            full = f"{package}/{other}/{name}"
+            articled = {MSG: "a message", SRV: "a service", ACTION: "an action"}
+            what, asked = articled[other], articled[kind]
+            parts = ""
+            if other == SRV and kind == MSG:
+                parts = f" (its messages are {full}_Request and {full}_Response)"
+            elif other == ACTION and kind == MSG:
+                parts = f" (its messages are {full}_Goal, {full}_Result and {full}_Feedback)"
+            return f"{full} is {what}, not {asked}{parts}: use {getter[other]}({full!r})"
     known = names(package, kind)
     hints = [f"{package}/{kind}/{match}" for match in close_matches(name, known)]
     suggestion = f" (did you mean {' or '.join(hints)}?)" if hints else ""

@@ -25,6 +25,61 @@ uint32 nanosec""",
     "builtin_interfaces/msg/Time": """\
 int32 sec
 uint32 nanosec""",
+    "example_interfaces/msg/Bool": "bool data",
+    "example_interfaces/msg/Byte": "byte data",
+    "example_interfaces/msg/ByteMultiArray": """\
+MultiArrayLayout layout
+byte[] data""",
+    "example_interfaces/msg/Char": "char data",
+    "example_interfaces/msg/Empty": "",
+    "example_interfaces/msg/Float32": "float32 data",
+    "example_interfaces/msg/Float32MultiArray": """\
+MultiArrayLayout layout
+float32[] data""",
+    "example_interfaces/msg/Float64": "float64 data",
+    "example_interfaces/msg/Float64MultiArray": """\
+MultiArrayLayout layout
+float64[] data""",
+    "example_interfaces/msg/Int16": "int16 data",
+    "example_interfaces/msg/Int16MultiArray": """\
+MultiArrayLayout layout
+int16[] data""",
+    "example_interfaces/msg/Int32": "int32 data",
+    "example_interfaces/msg/Int32MultiArray": """\
+MultiArrayLayout layout
+int32[] data""",
+    "example_interfaces/msg/Int64": "int64 data",
+    "example_interfaces/msg/Int64MultiArray": """\
+MultiArrayLayout layout
+int64[] data""",
+    "example_interfaces/msg/Int8": "int8 data",
+    "example_interfaces/msg/Int8MultiArray": """\
+MultiArrayLayout layout
+int8[] data""",
+    "example_interfaces/msg/MultiArrayDimension": """\
+string label
+uint32 size
+uint32 stride""",
+    "example_interfaces/msg/MultiArrayLayout": """\
+MultiArrayDimension[] dim
+uint32 data_offset""",
+    "example_interfaces/msg/String": "string data",
+    "example_interfaces/msg/UInt16": "uint16 data",
+    "example_interfaces/msg/UInt16MultiArray": """\
+MultiArrayLayout layout
+uint16[] data""",
+    "example_interfaces/msg/UInt32": "uint32 data",
+    "example_interfaces/msg/UInt32MultiArray": """\
+MultiArrayLayout layout
+uint32[] data""",
+    "example_interfaces/msg/UInt64": "uint64 data",
+    "example_interfaces/msg/UInt64MultiArray": """\
+MultiArrayLayout layout
+uint64[] data""",
+    "example_interfaces/msg/UInt8": "uint8 data",
+    "example_interfaces/msg/UInt8MultiArray": """\
+MultiArrayLayout layout
+uint8[] data""",
     "geometry_msgs/msg/Accel": """\
 Vector3 linear
 Vector3 angular""",
@@ -134,6 +189,10 @@ Vector3 torque""",
     "geometry_msgs/msg/WrenchStamped": """\
 std_msgs/Header header
 Wrench wrench""",
+    "nav2_msgs/msg/MissedWaypoint": """\
+uint32 index
+geometry_msgs/PoseStamped goal
+uint16 error_code""",
     "nav_msgs/msg/GridCells": """\
 std_msgs/Header header
 float32 cell_width
@@ -240,6 +299,16 @@ string reason""",
     "rcl_interfaces/msg/SetParametersResult": """\
 bool successful
 string reason""",
+    "robodojo_msgs/msg/ServiceCall": """\
+string service
+string reply_to
+uint32 id
+uint8[] request""",
+    "robodojo_msgs/msg/ServiceReply": """\
+uint32 id
+bool ok
+string error
+uint8[] response""",
     "rosgraph_msgs/msg/Clock": "builtin_interfaces/Time clock",
     "sensor_msgs/msg/BatteryState": """\
 uint8 POWER_SUPPLY_STATUS_UNKNOWN=0
@@ -679,7 +748,178 @@ float32 v""",
 }
 
 # Services: (request text, response text).
-SERVICES: dict[str, tuple[str, str]] = {}
+SERVICES: dict[str, tuple[str, str]] = {
+    "action_msgs/srv/CancelGoal": (
+        "GoalInfo goal_info",
+        """\
+int8 ERROR_NONE=0
+int8 ERROR_REJECTED=1
+int8 ERROR_UNKNOWN_GOAL_ID=2
+int8 ERROR_GOAL_TERMINATED=3
+int8 return_code
+GoalInfo[] goals_canceling""",
+    ),
+    "example_interfaces/srv/AddTwoInts": (
+        """\
+int64 a
+int64 b""",
+        "int64 sum",
+    ),
+    "example_interfaces/srv/SetBool": (
+        "bool data",
+        """\
+bool success
+string message""",
+    ),
+    "example_interfaces/srv/Trigger": (
+        "",
+        """\
+bool success
+string message""",
+    ),
+    "nav_msgs/srv/GetMap": (
+        "",
+        "OccupancyGrid map",
+    ),
+    "nav_msgs/srv/GetPlan": (
+        """\
+geometry_msgs/PoseStamped start
+geometry_msgs/PoseStamped goal
+float32 tolerance""",
+        "Path plan",
+    ),
+    "nav_msgs/srv/LoadMap": (
+        "string map_url",
+        """\
+uint8 RESULT_SUCCESS=0
+uint8 RESULT_MAP_DOES_NOT_EXIST=1
+uint8 RESULT_INVALID_MAP_DATA=2
+uint8 RESULT_INVALID_MAP_METADATA=3
+uint8 RESULT_UNDEFINED_FAILURE=255
+nav_msgs/OccupancyGrid map
+uint8 result""",
+    ),
+    "nav_msgs/srv/SetMap": (
+        """\
+nav_msgs/OccupancyGrid map
+geometry_msgs/PoseWithCovarianceStamped initial_pose""",
+        "bool success",
+    ),
+    "rcl_interfaces/srv/DescribeParameters": (
+        "string[] names",
+        "ParameterDescriptor[] descriptors",
+    ),
+    "rcl_interfaces/srv/GetLoggerLevels": (
+        "string[] names",
+        "LoggerLevel[] levels",
+    ),
+    "rcl_interfaces/srv/GetParameterTypes": (
+        "string[] names",
+        "uint8[] types",
+    ),
+    "rcl_interfaces/srv/GetParameters": (
+        "string[] names",
+        "ParameterValue[] values",
+    ),
+    "rcl_interfaces/srv/ListParameters": (
+        """\
+uint64 DEPTH_RECURSIVE=0
+string[] prefixes
+uint64 depth""",
+        "ListParametersResult result",
+    ),
+    "rcl_interfaces/srv/SetLoggerLevels": (
+        "LoggerLevel[] levels",
+        "SetLoggerLevelsResult[] results",
+    ),
+    "rcl_interfaces/srv/SetParameters": (
+        "Parameter[] parameters",
+        "SetParametersResult[] results",
+    ),
+    "rcl_interfaces/srv/SetParametersAtomically": (
+        "Parameter[] parameters",
+        "SetParametersResult result",
+    ),
+    "std_srvs/srv/Empty": (
+        "",
+        "",
+    ),
+    "std_srvs/srv/SetBool": (
+        "bool data",
+        """\
+bool success
+string message""",
+    ),
+    "std_srvs/srv/Trigger": (
+        "",
+        """\
+bool success
+string message""",
+    ),
+}
 
 # Actions: (goal text, result text, feedback text).
-ACTIONS: dict[str, tuple[str, str, str]] = {}
+ACTIONS: dict[str, tuple[str, str, str]] = {
+    "action_tutorials_interfaces/action/Fibonacci": (
+        "int32 order",
+        "int32[] sequence",
+        "int32[] partial_sequence",
+    ),
+    "example_interfaces/action/Fibonacci": (
+        "int32 order",
+        "int32[] sequence",
+        "int32[] sequence",
+    ),
+    "nav2_msgs/action/ComputePathToPose": (
+        """\
+geometry_msgs/PoseStamped goal
+geometry_msgs/PoseStamped start
+string planner_id
+bool use_start""",
+        """\
+uint16 NONE=0
+uint16 UNKNOWN=200
+uint16 INVALID_PLANNER=201
+uint16 TF_ERROR=202
+uint16 START_OUTSIDE_MAP=203
+uint16 GOAL_OUTSIDE_MAP=204
+uint16 START_OCCUPIED=205
+uint16 GOAL_OCCUPIED=206
+uint16 TIMEOUT=207
+uint16 NO_VALID_PATH=208
+nav_msgs/Path path
+builtin_interfaces/Duration planning_time
+uint16 error_code
+string error_msg""",
+        "",
+    ),
+    "nav2_msgs/action/FollowWaypoints": (
+        """\
+uint32 number_of_loops
+uint32 goal_index 0
+geometry_msgs/PoseStamped[] poses""",
+        """\
+uint16 NONE=0
+uint16 UNKNOWN=600
+uint16 TASK_EXECUTOR_FAILED=601
+MissedWaypoint[] missed_waypoints
+uint16 error_code
+string error_msg""",
+        "uint32 current_waypoint",
+    ),
+    "nav2_msgs/action/NavigateToPose": (
+        """\
+geometry_msgs/PoseStamped pose
+string behavior_tree""",
+        """\
+uint16 NONE=0
+uint16 error_code
+string error_msg""",
+        """\
+geometry_msgs/PoseStamped current_pose
+builtin_interfaces/Duration navigation_time
+builtin_interfaces/Duration estimated_time_remaining
+int16 number_of_recoveries
+float32 distance_remaining""",
+    ),
+}

@@ -85,3 +85,37 @@ def to_rosbags(message: Any, typestore: Any) -> Any:
                 dtype=numpy.dtype("<" + primitive.typecode),
             )
     return rosbags_cls(**values)
+
+
+def _rosbags_node(field: FieldSpec) -> tuple:
+    from rosbags.interfaces import Nodetype
+
+    if field.message_class is not None:
+        element: tuple = (Nodetype.NAME, field.base)
+    else:
+        element = (Nodetype.BASE, (field.base, field.string_bound or 0))
+    if field.container == "array":
+        return (Nodetype.ARRAY, (element, field.size))
+    if field.container == "sequence":
+        return (Nodetype.SEQUENCE, (element, field.size or 0))
+    return element
+
+
+def typestore_with(types: list[type]) -> Any:
+    """rosbags' Jazzy type store plus ``types`` (and what they nest), from our parsed fields."""
+    from rosbags.typesys import Stores, get_typestore
+
+    typestore = get_typestore(Stores.ROS2_JAZZY)
+    todo, definitions = list(types), {}
+    while todo:
+        cls = todo.pop()
+        if cls._type in typestore.types or cls._type in definitions:
+            continue
+        fields = [(f.name, _rosbags_node(f)) for f in cls._field_specs]
+        if not fields:
+            fields = [("structure_needs_at_least_one_member", _rosbags_node(
+                FieldSpec("x", "uint8", "uint8", None, None)))]  # fmt: skip
+        definitions[cls._type] = ([], fields)
+        todo += [f.message_class for f in cls._field_specs if f.message_class is not None]
+    typestore.register(definitions)
+    return typestore
