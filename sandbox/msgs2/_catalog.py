@@ -84,7 +84,7 @@ def unknown_type_sentence(type_name: str, kind: str = MSG) -> str:
             f"ROS 2 {noun} type {type_name!r} must be written 'package/{kind}/Name', "
             f"e.g. {example!r}"
         )
-    package, written_kind, name = parts
+    package, _, name = parts
     if package not in packages():
         return (
             f"unknown {noun} type {type_name!r}: RoboDojo has no ROS 2 package {package!r}; "

@@ -39,7 +39,9 @@ def _example_interfaces() -> dict[str, str]:
 
 EXTRA_MESSAGES: dict[str, str] = {
     **_example_interfaces(),
-    "nav2_msgs/msg/MissedWaypoint": "uint32 index\ngeometry_msgs/PoseStamped goal\nuint16 error_code",
+    "nav2_msgs/msg/MissedWaypoint": (
+        "uint32 index\ngeometry_msgs/PoseStamped goal\nuint16 error_code"
+    ),
     "robodojo_msgs/msg/ServiceCall": (
         "string service\nstring reply_to\nuint32 id\nuint8[] request"
     ),
@@ -68,8 +70,9 @@ SERVICES: dict[str, tuple[str, str]] = {
     ),
     "nav_msgs/srv/LoadMap": (
         "string map_url",
-        "uint8 RESULT_SUCCESS=0\nuint8 RESULT_MAP_DOES_NOT_EXIST=1\nuint8 RESULT_INVALID_MAP_DATA=2\n"
-        "uint8 RESULT_INVALID_MAP_METADATA=3\nuint8 RESULT_UNDEFINED_FAILURE=255\n"
+        "uint8 RESULT_SUCCESS=0\nuint8 RESULT_MAP_DOES_NOT_EXIST=1\n"
+        "uint8 RESULT_INVALID_MAP_DATA=2\nuint8 RESULT_INVALID_MAP_METADATA=3\n"
+        "uint8 RESULT_UNDEFINED_FAILURE=255\n"
         "nav_msgs/OccupancyGrid map\nuint8 result",
     ),
     "nav_msgs/srv/SetMap": (
