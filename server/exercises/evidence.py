@@ -1,5 +1,10 @@
 """What checks look at: a run's recording read back (every topic as (time, message) pairs), the
-true robot pose from /tf, the run's own metrics and the files its nodes saved."""
+true robot pose from /tf, the run's own metrics and the files its nodes saved.
+
+A ROS 2 run's recording (ros2msg schemas, CDR) reads back as ROS 1 message objects, converted
+with sandbox.msgs2.bridge, so a check is written once for both dialects (a stamp is `secs` and
+`nsecs` there too). A type with no ROS 1 twin (an action's status) stays a ROS 2 object.
+"""
 
 from __future__ import annotations
 
@@ -40,6 +45,8 @@ def load_evidence(result: RunResult, run_dir: Path) -> Evidence:
         with open(recording, "rb") as f:
             for schema, channel, message in make_reader(f).iter_messages(log_time_order=True):
                 decoded = get_message_class(schema.name).deserialize(message.data)
+                if schema.encoding == "ros2msg":
+                    decoded = _as_ros1(decoded)
                 time_s = message.log_time / 1e9
                 topic = channel.topic.lstrip("/")
                 if topic == "tf":
@@ -62,3 +69,12 @@ def load_evidence(result: RunResult, run_dir: Path) -> Evidence:
         pose_y=poses[:, 1],
         pose_yaw=poses[:, 2],
     )
+
+
+def _as_ros1(message: object) -> object:
+    from sandbox.msgs2.bridge import BridgeError, to_ros1
+
+    try:
+        return to_ros1(message)
+    except BridgeError:  # no ROS 1 twin: the check sees the ROS 2 message
+        return message

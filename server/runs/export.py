@@ -15,7 +15,8 @@ message's fields flattened with dotted names in definition order (``linear.x``,
 
 File names come from topic names: ``/ultrasonic/range_0`` -> ``ultrasonic__range_0.csv``.
 Messages are decoded with ``sandbox.msgs`` by schema name; a topic with no messages still gets a
-file with its header line.
+file with its header line. A ROS 2 recording (``ros2msg`` schemas, CDR) exports the same way with
+ROS 2 field names: a stamp is two columns, ``header.stamp.sec`` and ``header.stamp.nanosec``.
 """
 
 from __future__ import annotations
@@ -34,7 +35,7 @@ from mcap.exceptions import McapError
 from mcap.reader import NonSeekingReader, make_reader
 
 from sandbox.msgs import Message, get_message_class
-from sandbox.msgs._spec import FieldSpec
+from server.runs.message_fields import FieldShape, byte_value, field_shapes
 
 _NS_PER_S = 1_000_000_000  # [ns/s]
 _UNSAFE_CHARS = re.compile(r"[^\w.\-]+")
@@ -69,7 +70,7 @@ def _float32(value: float) -> str:
     return repr(_float32_number(float(value)))
 
 
-def _plain(field: FieldSpec) -> Callable[[Any], Any]:
+def _plain(field: FieldShape) -> Callable[[Any], Any]:
     """Converter of one element of `field` to a JSON-ready value."""
     kind = field.kind if field.message_class is None else "message"
     if kind == "message":
@@ -80,6 +81,8 @@ def _plain(field: FieldSpec) -> Callable[[Any], Any]:
         return lambda value: _float32_number(float(value))
     if kind == "bool":
         return bool
+    if kind == "byte":
+        return byte_value
     if kind == "string":
         return lambda value: value.decode("utf-8", "replace") if isinstance(value, bytes) else value
     return lambda value: value
@@ -87,7 +90,7 @@ def _plain(field: FieldSpec) -> Callable[[Any], Any]:
 
 def _as_dict(message: Message) -> dict[str, Any]:
     values = {}
-    for field in message._field_specs:  # type: ignore[attr-defined]
+    for field in field_shapes(type(message)):
         convert = _plain(field)
         value = getattr(message, field.name)
         if field.is_array:
@@ -107,7 +110,7 @@ def _items(value: Any) -> list[Any]:
 def _columns(cls: type[Message], prefix: str = "") -> list[tuple[str, list[str], Formatter]]:
     """(column name, attribute path, formatter) for every leaf of `cls`, definition order."""
     columns: list[tuple[str, list[str], Formatter]] = []
-    for field in cls._field_specs:  # type: ignore[attr-defined]
+    for field in field_shapes(cls):
         name = f"{prefix}{field.name}"
         nested = field.message_class
         if nested is not None and not field.is_array:
@@ -127,7 +130,7 @@ def _float32_array_json(values: Any) -> str:
     return "[" + ", ".join([_JSON_NON_FINITE.get(text, text) for text in texts]) + "]"
 
 
-def _formatter(field: FieldSpec) -> Formatter:
+def _formatter(field: FieldShape) -> Formatter:
     if field.is_array and field.code == "f":
         return _float32_array_json
     if field.is_array:
@@ -142,6 +145,8 @@ def _formatter(field: FieldSpec) -> Formatter:
         return _float32 if field.code == "f" else lambda value: repr(float(value))
     if kind == "bool":
         return lambda value: "true" if value else "false"
+    if kind == "byte":
+        return lambda value: str(byte_value(value))
     if kind == "string":
         return lambda value: value.decode("utf-8", "replace") if isinstance(value, bytes) else value
     return str
@@ -173,8 +178,8 @@ class _TopicCsv:
 
 def export_csv(mcap_path: Path, out_dir: Path) -> list[Path]:
     """Write one CSV per topic of the recording at `mcap_path` into `out_dir`; return the paths
-    in topic order. A schema that is not ``ros1msg`` or names a type ``sandbox.msgs`` does not
-    know is an error that names the topic."""
+    in topic order. A schema that is neither ``ros1msg`` nor ``ros2msg`` (with CDR messages), or
+    names a type ``sandbox.msgs`` does not know, is an error that names the topic."""
     mcap_path, out_dir = Path(mcap_path), Path(out_dir)
     if not mcap_path.is_file():
         raise FileNotFoundError(f"no recording at {mcap_path}")
@@ -209,11 +214,12 @@ def export_csv(mcap_path: Path, out_dir: Path) -> list[Path]:
 
 
 def _open_topic(files: dict[int, _TopicCsv], channel: Any, schema: Any, out_dir: Path) -> None:
-    if schema is None or schema.encoding != "ros1msg" or channel.message_encoding != "ros1":
+    encodings = (schema.encoding, channel.message_encoding) if schema is not None else None
+    if encodings not in (("ros1msg", "ros1"), ("ros2msg", "cdr")):
         encoding = None if schema is None else schema.encoding
         raise ValueError(
-            f"topic '{channel.topic}' is not ROS1-encoded (schema encoding {encoding!r}); "
-            "only RoboDojo recordings (ros1msg schemas) can be exported"
+            f"topic '{channel.topic}' is not ROS1-encoded nor ROS 2 CDR (schema encoding "
+            f"{encoding!r}); only RoboDojo recordings (ros1msg or ros2msg schemas) can be exported"
         )
     cls = get_message_class(schema.name)
     taken = {topic_csv.path.name for topic_csv in files.values()}

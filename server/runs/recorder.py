@@ -426,13 +426,13 @@ class Recorder:
                 if schema_id is None:
                     schema_id = writer.register_schema(
                         name=cls._type,
-                        encoding="ros2msg" if self._ros2 else "ros1msg",
+                        encoding=cls._schema_encoding,  # ros1msg or ros2msg
                         data=cls._full_text.encode(),
                     )
                     self._schemas[cls._type] = schema_id
                 channel_id = writer.register_channel(
                     topic=topic,
-                    message_encoding="cdr" if self._ros2 else "ros1",
+                    message_encoding=cls._message_encoding,  # ros1 or cdr
                     schema_id=schema_id,
                     metadata=rosbag2.channel_metadata(topic)
                     if self._ros2

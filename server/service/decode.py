@@ -6,7 +6,9 @@ seconds, byte strings and numpy arrays lists. JSON has no NaN or infinity (``JSO
 Python's ``NaN``), so non-finite floats become None - a LaserScan's "no return" reads as a gap.
 
 Conversion follows each class's parsed field specs, planned once per class, rather than
-inspecting every value: a 429-beam LaserScan converts in tens of microseconds.
+inspecting every value: a 429-beam LaserScan converts in tens of microseconds. ROS 2 messages
+(a ROS 2 run's "pkg/msg/Name" types, CDR bytes) convert the same way with their own field names:
+a stamp is ``{"sec": ..., "nanosec": ...}`` there, as `ros2 topic echo` shows it.
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ from collections.abc import Callable
 from typing import Any
 
 from sandbox.msgs import Duration, Message, Time, get_message_class
+from server.runs.message_fields import byte_value, field_shapes
 
 # An array longer than this is sent as {"omitted_items": n} instead of its items: a 200 x 200
 # OccupancyGrid (40 000 cells) is ~150 kB of JSON per frame, too much to push to every browser at
@@ -38,7 +41,8 @@ def to_jsonable(message: Message) -> dict[str, Any]:
 
 
 def decode(type_name: str, data: bytes) -> dict[str, Any]:
-    """Deserialize ROS1 bytes of ``type_name`` ("pkg/Name") and convert them for JSON."""
+    """Deserialize the bytes of ``type_name`` (ROS 1 "pkg/Name", or ROS 2 "pkg/msg/Name" with
+    CDR bytes) and convert them for JSON."""
     cls = _CLASSES.get(type_name)
     if cls is None:
         cls = _CLASSES[type_name] = get_message_class(type_name)
@@ -47,7 +51,7 @@ def decode(type_name: str, data: bytes) -> dict[str, Any]:
 
 # ------------------------------------------------------------------------------------ planning
 def _plan(cls: type) -> tuple[tuple[str, _Convert], ...]:
-    plan = tuple((spec.name, _converter(spec)) for spec in cls._field_specs)
+    plan = tuple((spec.name, _converter(spec)) for spec in field_shapes(cls))
     _PLANS[cls] = plan
     return plan
 
@@ -60,6 +64,8 @@ def _converter(spec: Any) -> _Convert:
         one = _float
     elif kind in ("time", "duration"):
         one = _seconds
+    elif kind == "byte":
+        one = byte_value
     else:  # int, bool, string: already plain (numpy scalars and the like are coerced)
         one = _plain
     if not spec.is_array:

@@ -85,9 +85,13 @@ class ViewState:
         return self.time_s < self.buzzer_until_s
 
     def apply(self, topic: str, type_name: str, time_s: float, msg: dict[str, Any]) -> None:
-        """Fold one decoded message in; a malformed one is ignored (the view shows what it can)."""
+        """Fold one decoded message in; a malformed one is ignored (the view shows what it can).
+        A ROS 2 type ("nav_msgs/msg/Path") is drawn as its ROS 1 twin: the fields drawn (poses,
+        frames, ranges) have the same names in both."""
         if not isinstance(msg, dict):
             return
+        if "/msg/" in type_name:
+            type_name = type_name.replace("/msg/", "/", 1)
         self.version += 1
         self.time_s = max(self.time_s, float(time_s))
         with contextlib.suppress(KeyError, TypeError, ValueError, IndexError):
