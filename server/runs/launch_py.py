@@ -200,6 +200,7 @@ def _node_specs(plan: Plan, files: dict[str, str | bytes]) -> tuple[NodeSpec, ..
                 remaps=tuple((source, target) for source, target in node.remaps),
                 args=tuple(node.args),
                 namespace=node.namespace or "/",
+                ros_version=2,  # a Python launch file's node is ROS 2 (spec.py decides the run)
             )
         )
     return tuple(specs)
