@@ -1,0 +1,1 @@
+"""The ROS 2 package `action_tutorials_interfaces` for student code: action."""

@@ -1,0 +1,1 @@
+"""The ROS 2 package `builtin_interfaces` for student code: msg."""

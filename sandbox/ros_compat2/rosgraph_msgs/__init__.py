@@ -1,0 +1,1 @@
+"""The ROS 2 package `rosgraph_msgs` for student code: msg."""

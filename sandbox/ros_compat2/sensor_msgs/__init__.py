@@ -1,0 +1,1 @@
+"""The ROS 2 package `sensor_msgs` for student code: msg."""
