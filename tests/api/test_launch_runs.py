@@ -213,3 +213,86 @@ def test_an_include_loop_is_a_422_quickly(lab):
         assert answer.status_code == 422, answer.text
         assert "line 2" in answer.json()["detail"], answer.json()
         assert time.monotonic() - began < 5.0
+
+
+# ---------------------------------------------------------------- ROS 2 Python launch files
+ROS2_NODE = """\
+import rclpy
+
+
+def main():
+    rclpy.init()
+    node = rclpy.create_node("chatter")
+    node.get_logger().info(f"rate {node.declare_parameter('rate', 1.0).value}")
+    rclpy.spin(node)
+
+
+if __name__ == "__main__":
+    main()
+"""
+ROS2_LAUNCH = """\
+from launch import LaunchDescription
+from launch.actions import DeclareLaunchArgument
+from launch.substitutions import LaunchConfiguration
+from launch_ros.actions import Node
+
+
+def generate_launch_description():
+    return LaunchDescription([
+        DeclareLaunchArgument("rate", default_value="5.0"),
+        Node(package="chat", executable="chatter", name="talker", namespace="robot1",
+             parameters=["config/chat.yaml", {"rate": LaunchConfiguration("rate")}],
+             remappings=[("out", "chatter")]),
+    ])
+"""
+ROS2_PARAMS = "/**:\n  ros__parameters:\n    rate: 2.0\n    frame: base_link\n"
+
+
+def test_a_ros2_launch_file_is_read_in_the_sandbox_into_the_runs_nodes(lab):
+    student = lab.student("ros2")
+    files = {"chatter.py": ROS2_NODE, "launch/chat.launch.py": ROS2_LAUNCH}
+    workspace(student, {**files, "config/chat.yaml": ROS2_PARAMS})
+    started = launch(student, "launch/chat.launch.py", args={"rate": "10.0"})
+    assert started.status_code == 201, started.text
+    run = wait_for_end(student, started.json()["id"])
+    assert [node["name"] for node in run["code"]] == ["talker"]
+    assert run["code"][0]["code"] == ROS2_NODE
+
+
+ROS2_MISTAKES = {
+    "syntax": ("def generate_launch_description(:\n", "bad.launch.py, line 1: invalid Python"),
+    "no_function": ("x = 1\n", "defines no generate_launch_description()"),
+    "outside_include": (
+        "from launch import LaunchDescription\n"
+        "from launch.actions import IncludeLaunchDescription\n"
+        "def generate_launch_description():\n"
+        "    return LaunchDescription([IncludeLaunchDescription('/etc/passwd')])\n",
+        "bad.launch.py, line 4: the included launch file '/etc/passwd' is outside your workspace",
+    ),
+    "outside_params": (
+        "from launch import LaunchDescription\n"
+        "from launch_ros.actions import Node\n"
+        "def generate_launch_description():\n"
+        "    return LaunchDescription([Node(package='chat', executable='chatter',\n"
+        "        parameters=['../../../etc/passwd'])])\n",
+        "bad.launch.py, line 4: the parameter file '../../../etc/passwd' is outside",
+    ),
+    "read_server_file": (
+        "from launch import LaunchDescription\n"
+        "def generate_launch_description():\n"
+        "    print(open('/etc/shadow').read())\n",
+        "bad.launch.py, line 3:",
+    ),
+}
+
+
+@pytest.mark.parametrize("mistake", sorted(ROS2_MISTAKES))
+def test_ros2_launch_file_mistakes_are_422_with_the_file_and_line(lab, mistake):
+    text, words = ROS2_MISTAKES[mistake]
+    student = lab.student("ros2_mistaken")
+    workspace(student, {"chatter.py": ROS2_NODE, "bad.launch.py": text})
+    answer = launch(student, "bad.launch.py")
+    assert answer.status_code == 422, answer.text
+    assert words in answer.json()["detail"], answer.json()
+    assert "root:" not in answer.text
+    assert student.get("/api/runs").json()["total"] == 0

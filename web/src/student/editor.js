@@ -37,7 +37,7 @@ const MAX_NODES = 8; // the API's limit of nodes in one run
 const NODE_NAME = /^[A-Za-z][A-Za-z0-9_]{0,39}$/;
 // A data file's path as the server takes it (server/service/workspace_files.py): at most two
 // folders, parts of letters, digits, _ - and ., and one of these endings.
-const DATA_FILE = /^([A-Za-z0-9_][A-Za-z0-9_.-]*\/){0,2}[A-Za-z0-9_][A-Za-z0-9_.-]*\.(csv|ya?ml|json|txt|launch|xml)$/i;
+const DATA_FILE = /^([A-Za-z0-9_][A-Za-z0-9_.-]*\/){0,2}[A-Za-z0-9_][A-Za-z0-9_.-]*\.(csv|ya?ml|json|txt|launch|xml|launch\.py)$/i;
 const MAX_DATA_BYTES = 1024 * 1024; // [B] the server's default cap per data file
 
 const tabsElement = byId("file-tabs");
@@ -150,7 +150,7 @@ export function nodes() {
     .filter((node) => node.code.trim() !== "");
 }
 
-/** The workspace's launch files (.launch, .xml), in tab order. */
+/** The workspace's launch files (.launch, .xml, .launch.py), in tab order. */
 export function launchFiles() {
   return readOnly ? [] : [...files.keys()].filter(isLaunchFile);
 }
@@ -546,10 +546,31 @@ function initAddNode() {
   input.addEventListener("input", () => input.setCustomValidity(""));
 }
 
-/** A skeleton for a new data file: a launch file gets a node to start from. */
+/** A skeleton for a new data file: a launch file gets a node to start from (a ROS 2 one for
+ * .launch.py, a ROS 1 one otherwise). */
 function dataTemplate(name) {
   if (!isLaunchFile(name)) return "";
   const node = [...files.keys()].find(isNodeFile) || "controller.py";
+  if (/\.launch\.py$/i.test(name)) {
+    return `from launch import LaunchDescription
+from launch.actions import DeclareLaunchArgument
+from launch.substitutions import LaunchConfiguration
+from launch_ros.actions import Node
+
+
+def generate_launch_description():
+    return LaunchDescription([
+        DeclareLaunchArgument("speed", default_value="0.2"),
+        Node(
+            package="my_pkg",
+            executable="${nodeOf(node)}",
+            name="${nodeOf(node)}",
+            output="screen",
+            parameters=[{"speed": LaunchConfiguration("speed")}],
+        ),
+    ])
+`;
+  }
   return `<launch>
   <node pkg="my_pkg" type="${node}" name="${nodeOf(node)}" output="screen">
     <!-- <param name="speed" value="0.2"/> -->
@@ -582,7 +603,7 @@ function initAddFile() {
   });
   const problemOf = (name) => {
     if (name.startsWith("/") || name.split("/").some((part) => part.startsWith("."))) return "a file stays inside the workspace: no hidden files, '..' or leading '/'";
-    if (!DATA_FILE.test(name)) return "a data file's name ends .csv, .yaml, .json, .txt, .launch or .xml (folders: config/gains.yaml)";
+    if (!DATA_FILE.test(name)) return "a data file's name ends .csv, .yaml, .json, .txt, .launch, .xml or .launch.py (folders: config/gains.yaml)";
     return null;
   };
   form.addEventListener("submit", (event) => {

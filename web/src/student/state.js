@@ -89,5 +89,6 @@ export function runHasTeleop(run) {
 export const fileOf = (node) => `${node}.py`;
 export const nodeOf = (filename) => filename.replace(/\.py$/, "");
 /** A node of a run started from the page: a .py file at the top of the workspace. */
-export const isNodeFile = (filename) => /^[^/]+\.py$/.test(filename);
-export const isLaunchFile = (filename) => /\.(launch|xml)$/i.test(filename);
+export const isNodeFile = (filename) => /^[^/]+\.py$/.test(filename) && !/\.launch\.py$/i.test(filename);
+// ROS 1 XML (.launch, .xml) or a ROS 2 Python launch file (.launch.py), read by the server.
+export const isLaunchFile = (filename) => /\.(launch|xml|launch\.py)$/i.test(filename);
