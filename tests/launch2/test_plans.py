@@ -49,6 +49,7 @@ TWO_NODES = """\
 def test_two_nodes_with_parameters_remaps_and_a_namespace(launcher):
     plan = plan_of(launcher, workspace(two=TWO_NODES), "two", speed="0.5")
     assert plan.ros_version == 2
+    assert {node.ros_version for node in plan.nodes} == {2}
     talker, listener = plan.nodes
     assert (talker.name, talker.filename, talker.namespace) == ("talker", "talker.py", "/")
     # The YAML's /** rule, then its talker rule (the code's node name), nested names dotted;
