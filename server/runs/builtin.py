@@ -63,7 +63,8 @@ class BuiltinNode:
     def graph_subscriptions(self) -> tuple[tuple[str, str], ...]:
         """(topic, type) the node is listed as subscribing to in the run's graph, delivered
         like `subscribes`. A service server needs its request topic here: a client's
-        wait_for_service looks for a subscriber of `__srv__/<service>`."""
+        wait_for_service looks for a subscriber of `__srv__/<service>`. (Topics known only in
+        start() go to `run.bus.declare_listener(name, topic, type)` and `subscribes`.)"""
         return ()
 
     def listens_to(self, topic: str) -> bool:

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from sandbox.protocol import Envelope, TopicDecl
+from sandbox.protocol import Envelope
 from server.runs.builtin import BUILTIN_NODES, BuiltinNode
 
 if TYPE_CHECKING:
@@ -51,15 +51,14 @@ class BuiltinHost:
     def start(self, run: Run) -> None:
         for node in self.nodes:
             run.bus.add_node(node.name)
-            subscriptions = [TopicDecl(topic, kind) for topic, kind in node.graph_subscriptions()]
-            if subscriptions:
-                run.bus.declare(node.name, [], subscriptions)
-                run.bus.deliver_directly(node.name)
-            # start() publishes the time-0 message; ticks follow one period later.
-            self._next_ns[node.name] = round(NS / node.rate_hz) if node.rate_hz else 0
+            for topic, kind in node.graph_subscriptions():
+                run.bus.declare_listener(node.name, topic, kind)
         # Every built-in is ready before any publishes (the planner needs its map before the
         # waypoints node sends the first goal).
         started = [(node, node.start(run)) for node in self.nodes]
+        for node in self.nodes:  # after start(): a node may take its rate from the run's params
+            # start() publishes the time-0 message; ticks follow one period later.
+            self._next_ns[node.name] = round(NS / node.rate_hz) if node.rate_hz else 0
         for node, published in started:
             self.publish(run, node, published)
 
@@ -68,6 +67,11 @@ class BuiltinHost:
         for topic, message in published:
             if node.ros2_native:
                 envelope = Envelope(topic, message._type, message.serialize())
+            elif "/msg/" in message._type:  # our mistake, said plainly
+                raise TypeError(
+                    f"built-in node '{node.name}' published a ROS 2 {message._type}; a built-in "
+                    "that speaks ROS 2 says ros2_native = True (server/runs/builtin.py)"
+                )
             else:
                 envelope = dialect.envelope(topic, message)
             run.bus.publish(node.name, envelope, run.time_s)

@@ -58,8 +58,6 @@ class TopicBus:
         self._seq = 0
         self.version = 0  # bumped whenever a node, a publisher or a subscriber comes or goes
         self._ended: set[str] = set()  # nodes that ended: not routed to, not in graph_topics
-        # Subscribers the run hands messages to itself (built-in nodes): in the graph, no inbox.
-        self._direct: set[str] = set()
 
     # ----------------------------------------------------------------------------- graph
     def add_node(self, name: str) -> None:
@@ -84,13 +82,16 @@ class TopicBus:
         self.declare_topic(name, type_name)
         self.topics[name].mixed = True
 
-    def deliver_directly(self, node: str) -> None:
-        """`node` (a built-in) is listed as a subscriber but gets its messages from the run
-        directly, so nothing is queued for it."""
-        self._direct.add(node)
-        inbox = self._inboxes[node]
-        inbox.queues.clear()
-        inbox.pending = 0
+    def declare_listener(self, node: str, name: str, type_name: str) -> None:
+        """A built-in node listens to topic `name` in-process (its host hands it the messages):
+        it shows in the graph as a subscriber - so clients see the services it serves - and
+        nothing is queued for it here."""
+        self.declare_topic(name, type_name)
+        topic = self.topics[name]
+        topic.subscribers.add(node)
+        if topic.mixed:
+            topic.subscriber_types[node] = type_name
+        self.version += 1
 
     def declare(self, node: str, advertised: list[TopicDecl], subscribed: list[TopicDecl]) -> None:
         """Record what a node said it publishes and subscribes to (from its Yield)."""
@@ -173,12 +174,14 @@ class TopicBus:
         topic.recent.append(time_s)
         self._seq += 1
         for name in topic.subscribers:
-            if name == publisher or name in self._ended or name in self._direct:
+            if name == publisher or name in self._ended:
                 continue
             if topic.mixed and topic.subscriber_types.get(name, envelope.type) != envelope.type:
                 continue
             inbox = self._inboxes[name]
-            self._enqueue(inbox, inbox.queues[envelope.topic], time_s, envelope, self._seq)
+            queue = inbox.queues.get(envelope.topic)
+            if queue is not None:  # None: a built-in listener (declare_listener)
+                self._enqueue(inbox, queue, time_s, envelope, self._seq)
 
     def _enqueue(
         self, inbox: _Inbox, queue: deque, time_s: float, envelope: Envelope, seq: int = 0

@@ -265,3 +265,20 @@ def test_a_ros2_native_builtin_is_left_out_of_a_ros1_run(tmp_path, monkeypatch):
     )
     run = Run(spec, launcher=None, out_dir=tmp_path)
     assert run.builtins.get("echo_service") is None
+
+
+class ForgetfulNative(BuiltinNode):
+    """Publishes a ROS 2 message without saying it speaks ROS 2."""
+
+    name = "forgetful"
+
+    def start(self, run):
+        return [("said", get_message_class("std_msgs/msg/String")(data="hi"))]
+
+
+def test_a_builtin_publishing_ros2_without_saying_so_gets_a_sentence(tmp_path, monkeypatch):
+    monkeypatch.setitem(BUILTIN_NODES, "forgetful", ForgetfulNative)
+    run = prepared(tmp_path, builtin_nodes=("forgetful",))
+    with pytest.raises(TypeError, match="says ros2_native = True"):
+        run.builtins.start(run)
+    run.recorder.close()
