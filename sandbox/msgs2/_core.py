@@ -21,7 +21,9 @@ from typing import Any, ClassVar, Self
 from sandbox.msgs._core import DeserializationError, SerializationError
 
 from . import _slot_types
-from ._cdr import BadValue, ShortBuffer, build_deserializer, build_serializer
+from ._cdr import BadValue, ShortBuffer
+from ._cdr_read import build_deserializer
+from ._cdr_write import build_serializer
 from ._fields import CHECK_FIELDS, make_default, make_property
 from ._fulltext import full_text
 from ._spec import FieldSpec, min_wire_size, parse_definition
