@@ -74,3 +74,15 @@ def test_mcap_ros2_reads_a_scan() -> None:
     decoded = _decode_with_mcap_ros2(scan)
     assert decoded.header.frame_id == "base_scan" and decoded.header.stamp.sec == 12
     assert list(decoded.ranges) == [0.5, 1.0, 3.5]
+
+
+def test_service_and_action_types_are_named_in_msg_syntax() -> None:
+    from sandbox.msgs2 import get_action_class
+
+    feedback = get_action_class("nav2_msgs/action/NavigateToPose").Impl.FeedbackMessage
+    text = feedback._full_text
+    assert text.startswith(
+        "unique_identifier_msgs/UUID goal_id\nnav2_msgs/NavigateToPose_Feedback feedback\n"
+    )
+    assert f"\n{DELIMITER}\nMSG: nav2_msgs/NavigateToPose_Feedback\n" in text
+    assert "/action/" not in text and "/msg/" not in text
