@@ -234,7 +234,8 @@ def _cmd_check(args: argparse.Namespace) -> int:
         unsafe_no_sandbox=args.unsafe_no_sandbox,
     )
     try:
-        result = grade(exercise, nodes, launcher, Path(args.out) if args.out else None)
+        clock = Clock(args.clock) if args.clock else None
+        result = grade(exercise, nodes, launcher, Path(args.out) if args.out else None, clock)
     finally:
         launcher.close()
     for run in result.runs:
@@ -338,6 +339,12 @@ def build_parser() -> argparse.ArgumentParser:
     check.add_argument("--reference", action="store_true", help="check the reference solution")
     check.add_argument("--starter", action="store_true", help="check the starter code")
     check.add_argument("--out", default=None, help="folder for the runs' recordings")
+    check.add_argument(
+        "--clock",
+        choices=[str(c) for c in Clock],
+        default=None,
+        help="run on this clock instead of the exercise's (lockstep or realtime)",
+    )
     check.add_argument("--unsafe-no-sandbox", action="store_true", help=argparse.SUPPRESS)
     check.set_defaults(func=_cmd_check)
 

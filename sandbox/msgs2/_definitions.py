@@ -840,6 +840,12 @@ uint64 depth""",
         "Parameter[] parameters",
         "SetParametersResult result",
     ),
+    "robodojo_msgs/srv/ComputeVelocityCommands": (
+        """\
+geometry_msgs/PoseStamped pose
+nav_msgs/Path path""",
+        "geometry_msgs/Twist cmd_vel",
+    ),
     "std_srvs/srv/Empty": (
         "",
         "",

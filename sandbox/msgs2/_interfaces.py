@@ -79,6 +79,13 @@ SERVICES: dict[str, tuple[str, str]] = {
         "nav_msgs/OccupancyGrid map\ngeometry_msgs/PoseWithCovarianceStamped initial_pose",
         "bool success",
     ),
+    # Ours: the service of the thesis's Stanley controller plugin (003_4f92d1fa0a49ddae.txt
+    # section 5.9): the robot's pose and the path in, the velocities the controller server
+    # publishes out (server/runs/nav2_server.py calls it each control period).
+    "robodojo_msgs/srv/ComputeVelocityCommands": (
+        "geometry_msgs/PoseStamped pose\nnav_msgs/Path path",
+        "geometry_msgs/Twist cmd_vel",
+    ),
     "rcl_interfaces/srv/DescribeParameters": (
         "string[] names",
         "ParameterDescriptor[] descriptors",

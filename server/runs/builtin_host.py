@@ -17,11 +17,15 @@ from typing import TYPE_CHECKING
 
 from sandbox.protocol import Envelope
 from server.runs.builtin import BUILTIN_NODES, BuiltinNode
+from server.runs.nav2_server import NavigationServer
 
 if TYPE_CHECKING:
     from server.runs.run import Run
 
 NS = 1_000_000_000
+# The navigation server joins the built-ins here, not in builtin.py: it builds on the planner
+# there and on the ROS 2 action wire, so builtin.py cannot import it.
+BUILTIN_NODES.setdefault(NavigationServer.name, NavigationServer)
 
 
 class BuiltinHost:

@@ -155,7 +155,7 @@ class RunSpec:
                     f"node '{node.name}' is larger than {MAX_CODE_BYTES // 1024} KiB of code"
                 )
         self.ros_version  # noqa: B018  # a run mixing ROS 1 and ROS 2 nodes is refused here
-        from server.runs.builtin import BUILTIN_NODES
+        from server.runs.builtin_host import BUILTIN_NODES
 
         for name in self.builtin_nodes:
             if name not in BUILTIN_NODES:

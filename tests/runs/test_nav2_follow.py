@@ -15,6 +15,7 @@ from server.runs.nav2_follow import (
     estimated_time_s,
     path_length_from,
 )
+from server.runs.nav2_navigation import NoPath, path_yaws, plan_path
 
 
 def test_goal_checker_is_stateful_about_xy_and_strict_about_yaw():
@@ -80,3 +81,42 @@ def test_follower_turns_in_place_then_tracks_an_l_shaped_path_to_the_goal_headin
     assert max(off) < 0.3
     assert max(abs(v) for *_, v, _ in trail) <= 0.3 + 1e-9
     assert abs(trail[-1][3]) < 0.06  # it slowed down to arrive
+
+
+class GridPlanner:
+    """The planner built-in's grid, for plan_path (a 1 m x 1 m room, 10 cm cells)."""
+
+    def __init__(self, blocked: np.ndarray) -> None:
+        from types import SimpleNamespace
+
+        self.blocked = blocked
+        self.grid = SimpleNamespace(
+            origin_x=0.0, origin_y=0.0, resolution=0.1, width=blocked.shape[1],
+            height=blocked.shape[0],
+        )  # fmt: skip
+
+    def _cell(self, x: float, y: float) -> tuple[int, int]:
+        return int(y / 0.1), int(x / 0.1)
+
+    def _centre(self, row: int, col: int) -> tuple[float, float]:
+        return (col + 0.5) * 0.1, (row + 0.5) * 0.1
+
+
+def test_plans_end_at_the_goal_and_unreachable_goals_are_sentences():
+    blocked = np.zeros((10, 10), dtype=bool)
+    blocked[:, 5] = True
+    blocked[9, 5] = False  # a gap at the top
+    planner = GridPlanner(blocked)
+    points = plan_path(planner, (0.15, 0.15, 0.0), (0.83, 0.21, 1.0))
+    assert tuple(points[-1]) == (0.83, 0.21) and tuple(points[0]) == pytest.approx((0.15, 0.15))
+    assert max(points[:, 1]) > 0.9  # through the gap
+    yaws = path_yaws(points, 1.0)
+    step = points[1] - points[0]
+    assert yaws[-1] == 1.0 and yaws[0] == pytest.approx(math.atan2(step[1], step[0]))
+    with pytest.raises(NoPath, match=r"the goal \(0.55, 0.35\) is in or too close to an obstacle"):
+        plan_path(planner, (0.15, 0.15, 0.0), (0.55, 0.35, 0.0))
+    with pytest.raises(NoPath, match="is outside the map"):
+        plan_path(planner, (0.15, 0.15, 0.0), (1.5, 0.5, 0.0))
+    blocked[9, 5] = True
+    with pytest.raises(NoPath, match=r"no path leads from \(0.15, 0.15\) to the goal"):
+        plan_path(planner, (0.15, 0.15, 0.0), (0.85, 0.25, 0.0))

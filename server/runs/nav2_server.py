@@ -1,0 +1,510 @@
+"""The built-in navigation server of ROS 2 runs: Nav2's `navigate_to_pose` and
+`follow_waypoints` actions, served over the rcl_action wire (nav2_wire.py) the way a Nav2 stack
+serves them, so rclpy's ActionClient and nav2_simple_commander's BasicNavigator work against it.
+
+One goal at a time, as bt_navigator runs one: a new NavigateToPose goal preempts the one
+running, which ends ABORTED (Nav2's SimpleActionServer aborts the current goal when it accepts
+a pending one). A goal is planned at once (nav2_navigation.plan_path: a goal that cannot be
+reached ends ABORTED with a sentence), then driven each control period until the goal checker
+says it is reached (SUCCEEDED), the progress checker says the robot is stuck (ABORTED), or a
+client cancels it (CANCELED). Recoveries (spin, back up, wait) are not run: number_of_recoveries
+stays 0 and a failure ends the goal.
+
+`follow_waypoints` is Nav2's waypoint follower: a NavigateToPose goal per waypoint (visible on
+navigate_to_pose's status topic, as the follower is its client), a 200 ms pause at each
+(WaitAtWaypoint's default), and - `stop_on_failure` true by default - ABORTED with the missed
+waypoint when one fails.
+
+Parameters (the run's params): `controller_frequency` [Hz] (Nav2's default 20), `controller_service`
+(a service a student node serves, robodojo_msgs/srv/ComputeVelocityCommands: the thesis's
+Stanley controller, 003_4f92d1fa0a49ddae.txt section 5.9; unset: the built-in follower),
+`xy_goal_tolerance` [m], `yaw_goal_tolerance` [rad] (Nav2's 0.25 and 0.25), `stop_on_failure`.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING, Any
+
+from sandbox.action_goals import Goal, GoalEvent, GoalStatus, GoalTransitionError
+from sandbox.msgs import get_message_class
+from sandbox.runtime import format_log_line
+from sandbox.services import request_topic
+from server.runs.builtin import BuiltinNode, Planner
+from server.runs.nav2_follow import GoalChecker, PurePursuit
+from server.runs.nav2_navigation import Navigation, NoPath, Pose, path_yaws, plan_path, yaw_of
+from server.runs.nav2_wire import (
+    SERVICE_CALL,
+    ActionWire,
+    ServiceClient,
+    duration_msg,
+    reply,
+    stamp_ns,
+    time_msg,
+)
+
+if TYPE_CHECKING:
+    from server.runs.run import Run
+
+NS = 1_000_000_000
+CONTROLLER_FREQUENCY_HZ = 20.0  # [Hz] Nav2's controller_server default
+SERVICE_PATIENCE_S = 1.0  # [s] a goal waits this long for an unserved controller service
+WAYPOINT_PAUSE_S = 0.2  # [s] WaitAtWaypoint's waypoint_pause_duration default (200 ms)
+CONTROLLER_SERVICE_TYPE = "robodojo_msgs/srv/ComputeVelocityCommands"
+NAVIGATE = "navigate_to_pose"
+FOLLOW = "follow_waypoints"
+COMPUTE_PATH = "compute_path_to_pose"
+GLOBAL_FRAMES = ("map", "")  # goal frames used as they are (Nav2 transforms others via tf)
+
+
+def _msg(name: str, **fields: Any) -> Any:
+    return get_message_class(name)(**fields)
+
+
+def _pose_stamped(x: float, y: float, yaw: float, time_ns: int) -> Any:
+    return _msg(
+        "geometry_msgs/msg/PoseStamped",
+        header=_msg("std_msgs/msg/Header", stamp=time_msg(time_ns), frame_id="map"),
+        pose=_msg(
+            "geometry_msgs/msg/Pose",
+            position=_msg("geometry_msgs/msg/Point", x=float(x), y=float(y)),
+            orientation=_msg(
+                "geometry_msgs/msg/Quaternion", z=math.sin(yaw / 2), w=math.cos(yaw / 2)
+            ),
+        ),
+    )
+
+
+def _twist(v: float, w: float) -> Any:
+    twist = _msg("geometry_msgs/msg/Twist")
+    twist.linear.x, twist.angular.z = float(v), float(w)
+    return twist
+
+
+# Result error codes as Nav2 Jazzy's servers give them (bt_navigator passes on the code of the
+# server that failed: the planner's 2xx, the controller's 1xx, its own 9xxx).
+ERROR_CODES = {
+    "NONE": 0,
+    "PREEMPTED": 0,  # Nav2 aborts a preempted goal with an empty result
+    "INVALID_CONTROLLER": 101,  # FollowPath
+    "FAILED_TO_MAKE_PROGRESS": 105,
+    "NO_VALID_CONTROL": 106,
+    "PLANNER_TF_ERROR": 202,  # ComputePathToPose
+    "GOAL_OUTSIDE_MAP": 204,
+    "GOAL_OCCUPIED": 206,
+    "NO_VALID_PATH": 208,
+    "NO_VALID_WAYPOINTS": 602,  # FollowWaypoints
+    "UNKNOWN": 9000,  # NavigateToPose
+    "FAILED_TO_LOAD_BEHAVIOR_TREE": 9001,
+    "TF_ERROR": 9002,
+}
+
+
+def _with_error(result: Any, code_name: str, message: str) -> Any:
+    """Fill a Jazzy result's error_code and error_msg (results before Jazzy have neither)."""
+    fields = result.get_fields_and_field_types()
+    if "error_msg" in fields:
+        result.error_msg = message
+    if "error_code" in fields:
+        result.error_code = ERROR_CODES[code_name or "NONE"]
+    return result
+
+
+class Mission:
+    """One FollowWaypoints goal: which waypoint, which failed, when the pause ends."""
+
+    def __init__(self, goal: Goal, poses: list[Any], first: int, loops: int) -> None:
+        self.goal, self.poses, self.index, self.loops = goal, poses, first, loops
+        self.loop = 0
+        self.missed: list[tuple[int, int]] = []  # (waypoint index, error code)
+        self.nav_uuid: bytes | None = None
+        self.resume_ns = 0
+
+
+class NavigationServer(BuiltinNode):
+    name = "nav2"
+    publishes = (("plan", "nav_msgs/msg/Path"),)
+    rate_hz = CONTROLLER_FREQUENCY_HZ
+    ros2_native = True
+
+    def graph_subscriptions(self) -> tuple[tuple[str, str], ...]:
+        """The actions' request topics: clients' wait_for_server looks for their subscriber."""
+        return tuple(
+            (request_topic(f"{action}/_action/{service}"), SERVICE_CALL)
+            for action in (NAVIGATE, FOLLOW, COMPUTE_PATH)
+            for service in ("send_goal", "get_result", "cancel_goal")
+        )
+
+    # ------------------------------------------------------------------ start
+    def start(self, run: Run) -> list[tuple[str, object]]:
+        from sandbox.msgs2 import get_action_class, get_service_class
+
+        if run.builtins.get("localization") is None:
+            raise ValueError(
+                "the nav2 built-in navigates on the localization built-in's pose; "
+                "add 'localization' to the run's built-in nodes"
+            )
+        params = run.spec.params
+        self.rate_hz = float(params.get("controller_frequency", CONTROLLER_FREQUENCY_HZ))
+        if not self.rate_hz > 0:
+            raise ValueError(f"controller_frequency must be above 0 Hz, not {self.rate_hz}")
+        self.planner = Planner()
+        self.planner.start(run)
+        self.xy_tol = float(params.get("xy_goal_tolerance", GoalChecker.xy_tolerance_m))
+        self.yaw_tol = float(params.get("yaw_goal_tolerance", GoalChecker.yaw_tolerance_rad))
+        self.stop_on_failure = bool(params.get("stop_on_failure", True))
+        self.navigate = ActionWire(NAVIGATE, get_action_class("nav2_msgs/action/NavigateToPose"))
+        self.follow = ActionWire(FOLLOW, get_action_class("nav2_msgs/action/FollowWaypoints"))
+        self.compute = ActionWire(
+            COMPUTE_PATH, get_action_class("nav2_msgs/action/ComputePathToPose")
+        )
+        service = params.get("controller_service")
+        self.client = (
+            ServiceClient(str(service), get_service_class(CONTROLLER_SERVICE_TYPE), self.name)
+            if service
+            else None
+        )
+        self.follower = PurePursuit()
+        self.pose: Pose | None = None
+        self.speed_m_s = 0.0
+        self.current: Navigation | None = None
+        self.mission: Mission | None = None
+        self.subscribes = ("pose",) + ((self.client.reply_topic,) if self.client else ())
+        for wire in (self.navigate, self.follow, self.compute):
+            for topic, type_name in wire.published:
+                run.bus.declare_topic(topic, type_name, self.name)
+            run.bus.topics[wire.status_topic].latched_by.add(self.name)  # transient local
+        return []
+
+    def log(self, run: Run, level: str, text: str) -> None:
+        run._emit_logs(self.name, [format_log_line(level, run.time_s, text)])
+
+    # ------------------------------------------------------------------ requests
+    def on_message(self, run: Run, topic: str, message: object) -> list[tuple[str, object]]:
+        if topic == "pose":
+            p = message.pose
+            self.pose = (p.position.x, p.position.y, yaw_of(p.orientation))
+            return []
+        if self.client is not None and topic == self.client.reply_topic:
+            return self._controller_answer(run, message)
+        for wire in (self.navigate, self.follow, self.compute):
+            if topic in wire.request_topics:
+                request = wire.request(topic, message)
+                if topic == wire.send_goal:
+                    return self._send_goal(run, wire, message, request)
+                if topic == wire.get_result:
+                    return self._get_result(wire, message, request)
+                return self._cancel(run, wire, message, request)
+        return []
+
+    def _send_goal(self, run: Run, wire: ActionWire, call: Any, request: Any) -> list:
+        uuid = bytes(request.goal_id.uuid)
+        try:
+            goal = wire.goals.accept(uuid, run.time_ns, request.goal)
+        except GoalTransitionError:
+            return [reply(call, wire.goal_response(False, run.time_ns))]
+        out = [reply(call, wire.goal_response(True, run.time_ns))]
+        goal.update(GoalEvent.EXECUTE)
+        out.append(wire.status())
+        if wire is self.navigate:
+            out += self._start_navigation(run, goal)
+        elif wire is self.follow:
+            out += self._start_mission(run, goal)
+        else:
+            out += self._compute_path(run, goal)
+        return out
+
+    def _compute_path(self, run: Run, goal: Goal) -> list:
+        """The planner server's ComputePathToPose: a path at once (not published on `plan`,
+        which shows the path being followed)."""
+        request, result = goal.request, self.compute.action.Result()
+        start = request.start.pose if request.use_start else None
+        begin = (start.position.x, start.position.y, yaw_of(start.orientation)) if start else None
+        end = request.goal.pose
+        try:
+            if (begin or self.pose) is None:
+                raise NoPath("no pose from the localization yet", "TF_ERROR")
+            points = plan_path(
+                self.planner, begin or self.pose, (end.position.x, end.position.y, 0.0)
+            )
+        except NoPath as error:
+            code = "PLANNER_TF_ERROR" if error.code == "TF_ERROR" else error.code
+            _with_error(result, code, str(error))
+            return self._end(run, self.compute, goal, GoalEvent.ABORT, result, str(error))
+        result.path = self._path_message(points, yaw_of(end.orientation), run.time_ns)
+        return self._end(run, self.compute, goal, GoalEvent.SUCCEED, result)
+
+    def _path_message(self, points: Any, goal_yaw: float, time_ns: int) -> Any:
+        path = _msg("nav_msgs/msg/Path")
+        path.header = _msg("std_msgs/msg/Header", stamp=time_msg(time_ns), frame_id="map")
+        path.poses = [
+            _pose_stamped(x, y, yaw, time_ns)
+            for (x, y), yaw in zip(points, path_yaws(points, goal_yaw), strict=True)
+        ]
+        return path
+
+    def _get_result(self, wire: ActionWire, call: Any, request: Any) -> list:
+        now, goal = wire.goals.result_request(bytes(request.goal_id.uuid), call)
+        if not now:
+            return []
+        if goal is None:
+            return [reply(call, wire.result_response(GoalStatus.UNKNOWN, None))]
+        return [reply(call, wire.result_response(goal.status, goal.result))]
+
+    def _cancel(self, run: Run, wire: ActionWire, call: Any, request: Any) -> list:
+        info = request.goal_info
+        code, canceling = wire.goals.cancel(bytes(info.goal_id.uuid), stamp_ns(info.stamp))
+        out = [reply(call, wire.cancel_response(code, canceling))]
+        if canceling:
+            out.append(wire.status())
+        for goal in canceling:
+            if wire is self.follow and self.mission is not None and self.mission.goal is goal:
+                mission, self.mission = self.mission, None
+                out += self._cancel_navigation(run, mission.nav_uuid)
+                out += self._end(
+                    run, self.follow, goal, GoalEvent.CANCELED, self._mission_result(mission)
+                )
+            elif wire is self.navigate:
+                out += self._cancel_navigation(run, goal.uuid)
+        return out
+
+    def _cancel_navigation(self, run: Run, uuid: bytes | None) -> list:
+        goal = self.navigate.goals.goals.get(uuid) if uuid else None
+        if goal is None or goal.status.terminal:
+            return []
+        if goal.status is not GoalStatus.CANCELING:
+            goal.update(GoalEvent.CANCEL_GOAL)
+        if self.current is not None and self.current.uuid == uuid:
+            return self._finish_navigation(run, GoalEvent.CANCELED, "", "canceled by a client")
+        result = self.navigate.action.Result()
+        return self._end(run, self.navigate, goal, GoalEvent.CANCELED, result)
+
+    # ------------------------------------------------------------------ navigation
+    def _start_navigation(self, run: Run, goal: Goal) -> list:
+        out = []
+        if self.current is not None:
+            out += self._finish_navigation(
+                run, GoalEvent.ABORT, "PREEMPTED", "preempted: a newer goal arrived"
+            )
+        self.current = None
+        target = goal.request.pose
+        frame = target.header.frame_id.strip("/")
+        if goal.request.behavior_tree:
+            return out + self._abort_now(
+                run, goal, "FAILED_TO_LOAD_BEHAVIOR_TREE",
+                "the lab's navigator runs Nav2's default behaviour tree only; "
+                "leave behavior_tree empty",
+            )  # fmt: skip
+        if frame not in GLOBAL_FRAMES:
+            return out + self._abort_now(
+                run, goal, "TF_ERROR",
+                f"the goal is in frame '{frame}'; the lab's navigator takes goals in 'map'",
+            )  # fmt: skip
+        if self.pose is None:
+            return out + self._abort_now(run, goal, "TF_ERROR", "no pose from the localization yet")
+        pose = target.pose
+        end = (pose.position.x, pose.position.y, yaw_of(pose.orientation))
+        try:
+            points = plan_path(self.planner, self.pose, end)
+        except NoPath as error:
+            self.log(run, "WARN", f"navigate_to_pose: {error}")
+            return out + self._abort_now(run, goal, error.code, str(error))
+        self.current = Navigation(
+            goal.uuid, end, points, run.time_ns, GoalChecker(self.xy_tol, self.yaw_tol)
+        )
+        self.follower.reset()
+        path = self._path_message(points, end[2], run.time_ns)
+        self.path_message = path
+        self.log(run, "INFO", f"navigate_to_pose: heading to ({end[0]:.2f}, {end[1]:.2f})")
+        return [*out, ("plan", path)]
+
+    def _abort_now(self, run: Run, goal: Goal, code: str, message: str) -> list:
+        result = _with_error(self.navigate.action.Result(), code, message)
+        out = self._end(run, self.navigate, goal, GoalEvent.ABORT, result, message)
+        return out + self._mission_step(run, goal, GoalStatus.ABORTED, result)
+
+    def _finish_navigation(self, run: Run, event: GoalEvent, code: str, message: str) -> list:
+        nav, self.current = self.current, None
+        if nav is None:
+            return []
+        goal = self.navigate.goals.goals[nav.uuid]
+        result = _with_error(self.navigate.action.Result(), code, message if code else "")
+        out = [(run.velocity_topic, _twist(0.0, 0.0))]
+        if message and event is not GoalEvent.SUCCEED:
+            self.log(run, "WARN" if event is GoalEvent.ABORT else "INFO",
+                     f"navigate_to_pose: {message}")  # fmt: skip
+        out += self._end(run, self.navigate, goal, event, result, message)
+        return out + self._mission_step(run, goal, goal.status, result)
+
+    def _end(self, run: Run, wire: ActionWire, goal: Goal, event: GoalEvent, result: Any,
+             message: str = "") -> list:  # fmt: skip
+        waiting = wire.goals.finish(goal, event, result, message)
+        out = [wire.status()]
+        response = wire.result_response(goal.status, result)
+        out += [reply(call, response) for call in waiting]
+        return out
+
+    # ------------------------------------------------------------------ control
+    def tick(self, run: Run) -> list[tuple[str, object]]:
+        out = self._mission_resume(run)
+        nav = self.current
+        if nav is None or self.pose is None:
+            return out
+        pose = self.pose
+        if nav.reached(pose):
+            return out + self._finish_navigation(run, GoalEvent.SUCCEED, "", "")
+        if not nav.progress.check(pose[0], pose[1], run.time_s):
+            return out + self._finish_navigation(
+                run, GoalEvent.ABORT, "FAILED_TO_MAKE_PROGRESS",
+                f"the robot moved less than {nav.progress.radius_m} m in "
+                f"{nav.progress.time_allowance_s:.0f} s; it is stuck",
+            )  # fmt: skip
+        if self.client is None:
+            v, w = self.follower.command(
+                pose, nav.points, nav.goal[2], nav.goal_checker.xy_reached, 1.0 / self.rate_hz
+            )
+            out.append((run.velocity_topic, _twist(v, w)))
+        else:
+            out += self._call_controller(run, nav, pose)
+        speed = run.sim.state.linear_m_s
+        feedback = self.navigate.action.Feedback(
+            current_pose=_pose_stamped(*pose, run.time_ns),
+            navigation_time=duration_msg((run.time_ns - nav.started_ns) / NS),
+            estimated_time_remaining=duration_msg(nav.eta_s(pose, speed)),
+            number_of_recoveries=0,
+            distance_remaining=nav.distance_remaining(pose),
+        )
+        out.append(self.navigate.feedback(nav.uuid, feedback))
+        return out
+
+    def _call_controller(self, run: Run, nav: Navigation, pose: Pose) -> list:
+        client = self.client
+        if not run.bus.has_subscribers(client.topic):
+            if nav.service_missing_since_ns is None:
+                nav.service_missing_since_ns = run.time_ns
+                self.log(run, "WARN", f"controller service '{client.service}' is not available")
+            if run.time_ns - nav.service_missing_since_ns >= SERVICE_PATIENCE_S * NS:
+                return self._finish_navigation(
+                    run, GoalEvent.ABORT, "INVALID_CONTROLLER",
+                    f"no node serves '{client.service}' ({CONTROLLER_SERVICE_TYPE}): the "
+                    "controller calls it every control period; create it with "
+                    "node.create_service()",
+                )  # fmt: skip
+            return [(run.velocity_topic, _twist(0.0, 0.0))]
+        nav.service_missing_since_ns = None
+        if nav.pending_call is not None:
+            nav.missed_periods += 1
+            if nav.missed_periods == 1:  # once per goal, not every period
+                self.log(
+                    run, "WARN",
+                    f"controller service '{client.service}' took longer than one control "
+                    f"period ({1.0 / self.rate_hz:.3f} s) to answer",
+                )  # fmt: skip
+            return []
+        request = client.service_class.Request(
+            pose=_pose_stamped(*pose, run.time_ns), path=self.path_message
+        )
+        nav.pending_call, message = client.call(request)
+        nav.pending_since_ns = run.time_ns
+        return [message]
+
+    def _controller_answer(self, run: Run, message: Any) -> list:
+        nav = self.current
+        if nav is None or message.id != nav.pending_call:
+            return []  # the answer to a goal that has ended
+        nav.pending_call = None
+        try:
+            response = self.client.response(message)
+        except ValueError as error:
+            return self._finish_navigation(
+                run, GoalEvent.ABORT, "NO_VALID_CONTROL",
+                f"controller service '{self.client.service}' failed: {error}",
+            )  # fmt: skip
+        twist = response.cmd_vel
+        return [(run.velocity_topic, _twist(twist.linear.x, twist.angular.z))]
+
+    # ------------------------------------------------------------------ waypoints
+    def _start_mission(self, run: Run, goal: Goal) -> list:
+        out = []
+        if self.mission is not None:  # the waypoint follower takes the new goal instead
+            old, self.mission = self.mission, None
+            out += self._end(run, self.follow, old.goal, GoalEvent.ABORT, self._mission_result(old))
+            out += self._cancel_navigation(run, old.nav_uuid)
+        request = goal.request
+        poses = list(request.poses)
+        first = int(getattr(request, "goal_index", 0))
+        loops = int(getattr(request, "number_of_loops", 0))
+        mission = Mission(goal, poses, first, loops)
+        if not poses or first >= len(poses):
+            result = _with_error(
+                self.follow.action.Result(), "NO_VALID_WAYPOINTS", "no waypoints to follow"
+            )
+            return out + self._end(run, self.follow, goal, GoalEvent.ABORT, result)
+        self.mission = mission
+        return out + self._mission_goal(run)
+
+    def _mission_goal(self, run: Run) -> list:
+        mission = self.mission
+        uuid = _uuid(mission, run)
+        target = mission.poses[mission.index]
+        request = self.navigate.action.Goal(pose=target)
+        goal = self.navigate.goals.accept(uuid, run.time_ns, request)
+        goal.update(GoalEvent.EXECUTE)
+        mission.nav_uuid = uuid
+        feedback = self.follow.action.Feedback(current_waypoint=mission.index)
+        return [
+            self.navigate.status(),
+            self.follow.feedback(mission.goal.uuid, feedback),
+            *self._start_navigation(run, goal),
+        ]
+
+    def _mission_step(self, run: Run, goal: Goal, status: GoalStatus, result: Any) -> list:
+        """A navigation ended: if it was the mission's, note it and go on after the pause."""
+        mission = self.mission
+        if mission is None or goal.uuid != mission.nav_uuid:
+            return []
+        mission.nav_uuid = None
+        if status is GoalStatus.SUCCEEDED:
+            mission.resume_ns = run.time_ns + round(WAYPOINT_PAUSE_S * NS)
+            return []
+        mission.missed.append((mission.index, int(getattr(result, "error_code", 0))))
+        if self.stop_on_failure or status is GoalStatus.CANCELED:
+            self.mission = None
+            return self._end(
+                run, self.follow, mission.goal, GoalEvent.ABORT, self._mission_result(mission)
+            )
+        mission.resume_ns = run.time_ns
+        return []
+
+    def _mission_resume(self, run: Run) -> list:
+        mission = self.mission
+        if mission is None or mission.nav_uuid is not None or run.time_ns < mission.resume_ns:
+            return []
+        mission.index += 1
+        if mission.index >= len(mission.poses):
+            if mission.loop >= mission.loops:
+                self.mission = None
+                result = self._mission_result(mission)
+                return self._end(run, self.follow, mission.goal, GoalEvent.SUCCEED, result)
+            mission.index, mission.loop = 0, mission.loop + 1
+        return self._mission_goal(run)
+
+    def _mission_result(self, mission: Mission) -> Any:
+        result = self.follow.action.Result()
+        fields = result.get_fields_and_field_types()
+        if fields.get("missed_waypoints", "").startswith("sequence<int32"):
+            result.missed_waypoints = [index for index, _ in mission.missed]  # Humble
+        else:
+            missed = get_message_class("nav2_msgs/msg/MissedWaypoint")
+            result.missed_waypoints = [
+                missed(index=index, goal=mission.poses[index], error_code=code)
+                for index, code in mission.missed
+            ]
+        return result
+
+
+def _uuid(mission: Mission, run: Run) -> bytes:
+    """A goal id for the waypoint follower's own NavigateToPose goals: unique in the run and
+    the same from run to run (lockstep runs repeat byte for byte)."""
+    counter = run.time_ns.to_bytes(8, "big") + mission.index.to_bytes(4, "big")
+    return b"wp" + mission.goal.uuid[:2] + counter
