@@ -200,12 +200,21 @@ def _value_to_ros2(field: FieldSpec, ros1_field: Any) -> Callable[[Any], Any]:
     if field.is_numeric_container:
         typecode = field.primitive.typecode  # type: ignore[union-attr]
         if field.container == "sequence":
-            return lambda values: array(typecode, values)
+            return lambda values: _to_array(typecode, values)
         import numpy
 
         dtype = NUMPY_DTYPES[typecode]
         return lambda values: numpy.array(values, dtype=dtype)
     return lambda values: [element(value) for value in values]
+
+
+def _to_array(typecode: str, values: Any) -> array:
+    """A numeric sequence as ROS 2 holds it; numpy input (the simulator's) moves as one buffer."""
+    if getattr(values, "dtype", None) is None:
+        return array(typecode, values)
+    result = array(typecode)
+    result.frombytes(values.astype(NUMPY_DTYPES[typecode], copy=False).tobytes())
+    return result
 
 
 def _plan_to_ros1(source: type, target: type) -> Callable[[Any], Any]:

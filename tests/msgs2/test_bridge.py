@@ -111,3 +111,17 @@ def test_a_scan_converts_well_within_a_10_hz_budget() -> None:
         to_ros1(to_ros2(scan))
     per_round_trip = (time.perf_counter() - started) / 100
     assert per_round_trip < 0.005  # [s]; measured ~35 us, the period is 100 ms
+
+
+def test_numpy_values_from_the_simulator_convert() -> None:
+    import numpy
+
+    scan = ros1_class("sensor_msgs/LaserScan")(
+        ranges=numpy.linspace(0.5, 2.0, 4, dtype=numpy.float32), intensities=numpy.ones(4)
+    )
+    converted = to_ros2(scan)
+    assert list(converted.ranges) == [0.5, 1.0, 1.5, 2.0] and converted.ranges.typecode == "f"
+    assert list(converted.intensities) == [1.0] * 4 and converted.intensities.typecode == "f"
+    grid = ros1_class("nav_msgs/OccupancyGrid")(data=numpy.array([-1, 0, 100], dtype=numpy.int8))
+    assert list(to_ros2(grid).data) == [-1, 0, 100]
+    get_message_class("nav_msgs/msg/OccupancyGrid").deserialize(to_ros2(grid).serialize())
