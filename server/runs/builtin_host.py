@@ -80,8 +80,10 @@ class BuiltinHost:
                 envelope = dialect.envelope(topic, message)
             run.bus.publish(node.name, envelope, run.time_s)
             run.record(topic, envelope.type, run.time_ns, envelope.data)
-            if topic in run.sim.robot.commands and not run.faults.motors_stalled():
-                ros1 = dialect.to_ros1(message) if node.ros2_native else message
+            command = run.sim.robot.commands.get(topic)
+            if command is not None and not run.faults.motors_stalled():
+                # A native built-in's TwistStamped reaches a Twist topic as its twist.
+                ros1 = dialect.to_ros1(message, command[0]._type) if node.ros2_native else message
                 run.sim.apply(topic, ros1)  # trusted: a rejection is our bug, let it raise
             self.deliver(run, node.name, topic, message, node.ros2_native)
 

@@ -233,7 +233,12 @@ class EchoService(BuiltinNode):
 
     def on_message(self, run, topic, message):
         self.seen = message
-        return [("echoed", get_message_class("std_msgs/msg/String")(data=message.data + "!"))]
+        drive = TwistStamped2()
+        drive.twist.linear.x = 0.05
+        return [
+            ("echoed", get_message_class("std_msgs/msg/String")(data=message.data + "!")),
+            ("Control", drive),  # as Nav2's controller would on a Jazzy TurtleBot3
+        ]
 
 
 def test_a_ros2_native_builtin_is_a_graph_subscriber_and_speaks_ros2(tmp_path, monkeypatch):
@@ -247,6 +252,7 @@ def test_a_ros2_native_builtin_is_a_graph_subscriber_and_speaks_ros2(tmp_path, m
     run._from_node(run.slots["driver"], [Envelope("__srv__/echo", call._type, call.serialize())])
     assert run.builtins.get("echo_service").seen == call  # the ROS 2 object, not a ROS 1 one
     assert [(t, m.data) for t, _, m in received(run)] == [("echoed", "hello!")]
+    assert run.sim.read("Control").linear.x == pytest.approx(0.05)  # the twist of it
     assert not run.bus.has_pending("echo_service")  # delivered directly, nothing queued
     paths = run.recorder.close()
     with open(paths["recording"], "rb") as handle:
