@@ -185,6 +185,24 @@ def check_sync_call_timer(outcome: Outcome) -> None:
     assert [int(a) for a in served] == [3 * k for k in range(8)], served
 
 
+def check_rate_in_thread(outcome: Outcome) -> None:
+    assert_log(outcome, "rate_in_thread", r"step 2: v=0\.15 w=0\.00")
+    assert_log(outcome, "rate_in_thread", r"L done")
+    assert outcome.reason == "finished: every node ended", outcome.reason
+    # 0.3 m ahead, a quarter turn left, 0.3 m ahead: open loop, so a realtime run on a loaded
+    # machine may cut or stretch a leg by a wake-up or two.
+    realtime = outcome.clock is Clock.REALTIME
+    start, end = outcome.start, outcome.end
+    assert angle_between(end.yaw, start.yaw) == pytest.approx(
+        math.pi / 2, abs=0.35 if realtime else 0.15
+    )
+    heading = start.yaw + math.pi / 2
+    expected_x = start.x + 0.3 * math.cos(start.yaw) + 0.3 * math.cos(heading)
+    expected_y = start.y + 0.3 * math.sin(start.yaw) + 0.3 * math.sin(heading)
+    miss = math.hypot(end.x - expected_x, end.y - expected_y)
+    assert miss < (0.2 if realtime else 0.1), (end, expected_x, expected_y)
+
+
 def check_tf2_odom_distance(outcome: Outcome) -> None:
     assert_log(outcome, "tf2_odom_distance", r"travelled 0\.3\d m")
     assert outcome.travelled_between(0.0, outcome.end.t) == travelled(outcome, 0.3, 0.05)

@@ -166,6 +166,15 @@ CASES = (
         nodes=(Node("add_two_ints_server.py"), Node("sync_call_timer.py")),
     ),
     ros2_case(
+        "rate_in_thread",
+        "turtlebot",
+        "office",
+        7.5,
+        checks.check_rate_in_thread,
+        nodes=(Node("rate_in_thread.py"),),
+        spawn="start",
+    ),
+    ros2_case(
         "tf2_odom_distance",
         "turtlebot3",
         "office",

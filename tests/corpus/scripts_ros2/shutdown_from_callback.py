@@ -29,7 +29,6 @@ def main():
     node = DriveToWall()
     rclpy.spin(node)
     node.get_logger().info("spin returned")
-    node.destroy_node()
 
 
 if __name__ == "__main__":
