@@ -7,6 +7,7 @@ whole evaluation runs within the first-step budget, so a launch file that loops 
 from __future__ import annotations
 
 import errno
+import os
 import socket
 import traceback
 
@@ -52,9 +53,20 @@ def _student_error(error: BaseException, main_file: str) -> Exited:
             " (a launch file is read in the sandbox: it cannot open network connections or "
             "start programs)"
         )
+    elif isinstance(error, KeyError) and frames and _environment_lookup(error):
+        message += (
+            " (the launch file reads an environment variable; a run has none: use a launch "
+            "argument, or os.environ.get('NAME', 'default'))"
+        )
     elif isinstance(error, RecursionError):
         message = "RecursionError: the launch description nests too deeply (an endless include?)"
     return _error(message, filename, line)
+
+
+def _environment_lookup(error: KeyError) -> bool:
+    """Whether a KeyError came from os.environ[...] (its last frame is in the os module)."""
+    last = traceback.extract_tb(error.__traceback__)[-1]
+    return last.filename == "<frozen os>" or os.path.basename(last.filename) == "os.py"
 
 
 def run_launch(load: Load, workdir: str) -> Exited:

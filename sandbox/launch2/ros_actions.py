@@ -54,7 +54,7 @@ class Node(Action):
     def __init__(
         self,
         *,
-        executable: Any,
+        executable: Any = None,
         package: Any = None,
         name: Any = None,
         namespace: Any = None,
@@ -78,7 +78,18 @@ class Node(Action):
         on_exit: Any = None,
         **kwargs: Any,
     ) -> None:
+        for old_name in ("node_executable", "node_name", "node_namespace"):
+            if old_name in kwargs:  # ROS 2 Dashing/Eloquent's spelling, removed in Galactic
+                raise LaunchError(
+                    f"Node({old_name}=...) is the spelling of ROS 2 Eloquent and before; write "
+                    f"{old_name.removeprefix('node_')}=..."
+                )
         super().__init__(**kwargs)
+        if executable is None:
+            raise LaunchError(
+                "Node(...) needs executable=: the node's program, e.g. executable='talker' "
+                "(a setup.py console_scripts name, or the workspace file talker.py)"
+            )
         self.executable = normalize(executable, "Node's executable")
         self.package = None if package is None else normalize(package, "Node's package")
         self.name = None if name is None else normalize(name, "Node's name")

@@ -164,3 +164,11 @@ def test_ros2_xml_and_yaml_launch_files_are_not_read(launcher):
 def test_a_python_node_is_not_a_launch_file(launcher):
     with pytest.raises(LaunchFileError, match=r"defines no generate_launch_description\(\)"):
         read_launch("my_pkg/my_pkg/talker.py", workspace(), {}, launcher)
+
+
+def test_an_environment_variable_and_old_spellings_get_a_hint(launcher):
+    error = error_of(launcher, launch("    import os\n    os.environ['TURTLEBOT3_MODEL']\n"))
+    assert_error(error, 7, r"KeyError: 'TURTLEBOT3_MODEL'", r"a run has none: use a launch arg")
+    body = "    return LaunchDescription([Node(package='my_pkg', node_executable='talker')])\n"
+    error = error_of(launcher, launch(body))
+    assert_error(error, 6, r"Eloquent and before; write executable=\.\.\.")
