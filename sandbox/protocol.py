@@ -74,6 +74,9 @@ class RobotTopic(msgspec.Struct, frozen=True):
     type: str
     direction: str
     rate_hz: float | None = None
+    # Every type a command topic takes, when it takes more than `type`: a ROS 2 robot's Twist
+    # topic also takes TwistStamped (ROS 2 Jazzy's TurtleBot3 sends it). Empty: just `type`.
+    accepts: list[str] = []
 
 
 class NodeInfo(msgspec.Struct, frozen=True):

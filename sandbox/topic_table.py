@@ -30,9 +30,12 @@ class TopicTable:
         self._warn = warn
         self.types: dict[str, str] = {}  # topic -> type, the robot's and new ones
         self._robot: dict[str, tuple[str, str]] = {}  # name -> (type, direction)
+        self._accepts: dict[str, list[str]] = {}  # robot topics taking several types
         for topic in info.robot_topics:
             self._robot[topic.name] = (topic.type, topic.direction)
             self.types[topic.name] = topic.type
+            if topic.accepts:
+                self._accepts[topic.name] = topic.accepts
         self.advertised: set[str] = set()
         self.subscribed: set[str] = set()
         self._latched: set[str] = set()
@@ -113,7 +116,11 @@ class TopicTable:
             )
         known = self.types.get(name)
         if known is not None and known != type_name:
-            raise self._error(f"topic '{name}' carries {known}, not {type_name}")
+            accepted = self._accepts.get(name)
+            if accepted is None:
+                raise self._error(f"topic '{name}' carries {known}, not {type_name}")
+            if type_name not in accepted:
+                raise self._error(f"topic '{name}' takes {' or '.join(accepted)}, not {type_name}")
         return type_name
 
     # ------------------------------------------------------------------ declarations

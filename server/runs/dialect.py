@@ -63,6 +63,12 @@ class Dialect:
             return (self.type_name(TWIST), self.type_name(TWIST_STAMPED))
         return (self.type_name(ros1_type),)
 
+    def command_types(self, ros1_type: str, direction: str) -> list[str]:
+        """`RobotTopic.accepts` of one robot topic: every type it takes when that is more than
+        one (the sandbox then lets a node publish any of them), else []."""
+        accepted = self.accepted_types(ros1_type) if str(direction) == "subscribe" else ()
+        return list(accepted) if len(accepted) > 1 else []
+
     # ----------------------------------------------------------------------------- outgoing
     def envelope(self, topic: str, message: Any) -> Envelope:
         """A ROS 1 message of the robot, the run or a built-in as the nodes receive it."""

@@ -201,7 +201,13 @@ class Run(RunControls, RunOutputs):
 
     def _node_info(self, node: NodeSpec) -> NodeInfo:
         topics = [
-            RobotTopic(t.name, self.dialect.type_name(t.type_name), str(t.direction), t.rate_hz)
+            RobotTopic(
+                t.name,
+                self.dialect.type_name(t.type_name),
+                str(t.direction),
+                t.rate_hz,
+                accepts=self.dialect.command_types(t.type_name, t.direction),
+            )
             for t in self.sim.topics
         ]
         goal_type = self.dialect.type_name(PoseStamped._type)
