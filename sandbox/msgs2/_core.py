@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import re
 import threading
+import warnings
 from typing import Any, ClassVar, Self
 
 from sandbox.msgs._core import DeserializationError, SerializationError
@@ -141,12 +142,16 @@ class Message(metaclass=_MessageMeta):
     def __init__(self, **kwargs: Any) -> None:
         check = kwargs.get("check_fields", CHECK_FIELDS)
         self._check_fields = check
-        if check and not self._accepted.issuperset(kwargs):  # type: ignore[attr-defined]
+        if not self._accepted.issuperset(kwargs):  # type: ignore[attr-defined]
             unknown = sorted(set(kwargs) - self._accepted)  # type: ignore[attr-defined]
-            raise AssertionError(
-                f"Invalid arguments passed to constructor: {', '.join(unknown)} "
-                f"({self._type} has the fields {', '.join(self._slot_of) or 'none'})"  # type: ignore[attr-defined]
+            sentence = (
+                f"{', '.join(unknown)} ({self._type} has the fields "
+                f"{', '.join(self._slot_of) or 'none'})"  # type: ignore[attr-defined]
             )
+            if check:
+                raise AssertionError(f"Invalid arguments passed to constructor: {sentence}")
+            # Jazzy's rosidl ignores them silently; the script runs, but a typo is worth a line.
+            warnings.warn(f"ignored unknown constructor arguments: {sentence}", stacklevel=2)
         for name, store, default in self._defaults:  # type: ignore[attr-defined]
             if name in kwargs:
                 setattr(self, name, kwargs[name])

@@ -7,11 +7,12 @@ instance's ``_check_fields`` is true, then stores it, converting numeric sequenc
 False, '', a new nested message, ``array.array(code)``, ``numpy.zeros(n, dtype)``, an empty list,
 or the definition's default value.
 
-``_check_fields``: rosidl (Jazzy) turns the checks on when the environment variable
-``ROS_PYTHON_CHECK_FIELDS`` is ``1`` (before Jazzy they were always on). RoboDojo keeps them on
-by default (``CHECK_FIELDS``): a student learns at the assignment, on their own line, that
-``twist.linear.x = 1`` wants ``1.0``, where unchecked they would learn it at publish time. A
-message built with ``check_fields=False`` skips them, as in rosidl.
+``_check_fields``: rosidl (Jazzy) turns the checks on only when the environment variable
+``ROS_PYTHON_CHECK_FIELDS`` is ``1`` (before Jazzy they were always on). RoboDojo follows Jazzy,
+the distribution it models (``CHECK_FIELDS`` off): a script Jazzy's rclpy accepts, such as one
+writing ``twist.linear.x = 1``, must run here too. A wrong value is still caught, at publish,
+by the serializer, with the same sentence naming the field. ``check_fields=True`` in a
+constructor turns the checks on for that message, as in rosidl.
 """
 
 from __future__ import annotations
@@ -24,7 +25,7 @@ from typing import Any
 
 from ._spec import FLOAT_BOUNDS, INT_RANGES, NUMPY_DTYPES, FieldSpec
 
-CHECK_FIELDS = True  # rosidl's ROS_PYTHON_CHECK_FIELDS=1 behaviour, see the docstring
+CHECK_FIELDS = False  # Jazzy's default (ROS_PYTHON_CHECK_FIELDS unset), see the docstring
 
 
 def _element_check(field: FieldSpec) -> tuple[Callable[[Any], bool], str]:

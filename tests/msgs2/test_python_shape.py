@@ -9,7 +9,7 @@ from array import array
 import numpy
 import pytest
 
-from sandbox.msgs2 import UnknownMessageTypeError, get_message_class
+from sandbox.msgs2 import SerializationError, UnknownMessageTypeError, get_message_class
 from sandbox.msgs2._slot_types import BasicType, NamespacedType, UnboundedSequence
 
 Int32 = get_message_class("std_msgs/msg/Int32")
@@ -27,11 +27,14 @@ def test_repr_type_name_and_module_follow_rosidl() -> None:
     assert "ranges=[1.5, 2.0], intensities=[]" in repr(scan)
 
 
-def test_the_constructor_takes_keywords_only_and_refuses_unknown_ones() -> None:
+def test_the_constructor_takes_keywords_only_and_warns_of_unknown_ones() -> None:
     with pytest.raises(TypeError):
         Int32(3)  # type: ignore[misc]
+    # Jazzy ignores an unknown keyword unless the checks are on; we say so in the log.
+    with pytest.warns(UserWarning, match="ignored unknown constructor arguments: dta"):
+        assert Int32(dta=3).data == 0
     with pytest.raises(AssertionError, match="Invalid arguments passed to constructor: dta"):
-        Int32(dta=3)
+        Int32(dta=3, check_fields=True)
 
 
 def test_defaults_come_from_the_definition() -> None:
@@ -46,21 +49,32 @@ def test_defaults_come_from_the_definition() -> None:
     assert odom.header.frame_id == "" and odom.header.stamp.nanosec == 0
 
 
-def test_setters_check_types_and_ranges_with_assertion_errors() -> None:
-    twist = Twist()
+def test_setters_check_types_and_ranges_with_assertion_errors_when_asked() -> None:
+    Vector3 = get_message_class("geometry_msgs/msg/Vector3")
+    vector = Vector3(check_fields=True)
     with pytest.raises(AssertionError, match="'x' field must be a double"):
-        twist.linear.x = 1  # an int into a float64 field, as rosidl refuses it
+        vector.x = 1  # an int into a float64 field, as rosidl refuses it when checking
     with pytest.raises(AssertionError, match="sub message of type 'Vector3'"):
-        twist.linear = 5
+        Twist(check_fields=True).linear = 5
     UInt8 = get_message_class("std_msgs/msg/UInt8")
     with pytest.raises(AssertionError, match=r"\[0, 255\]"):
-        UInt8(data=256)
+        UInt8(data=256, check_fields=True)
     with pytest.raises(AssertionError, match="each value"):
-        LaserScan(ranges=["a"])
-    with pytest.raises(AssertionError, match="length 36"):
-        Odometry().pose.covariance = [0.0] * 35
-    twist.linear.x = 0.5
-    assert twist.linear.x == 0.5
+        LaserScan(ranges=["a"], check_fields=True)
+    vector.x = 0.5
+    assert vector.x == 0.5
+
+
+def test_unchecked_fields_take_what_jazzy_takes_and_fail_at_serialize() -> None:
+    twist = Twist()
+    twist.linear.x = 1  # Jazzy (ROS_PYTHON_CHECK_FIELDS unset) accepts an int here
+    assert Twist.deserialize(twist.serialize()).linear.x == 1.0
+    UInt8 = get_message_class("std_msgs/msg/UInt8")
+    with pytest.raises(SerializationError, match=r"UInt8.data: .*\[0, 255\], got 256"):
+        UInt8(data=256).serialize()
+    odom = Odometry()
+    with pytest.raises(AssertionError, match="exactly 36 values"):
+        odom.pose.covariance = [0.0] * 35  # a fixed array's numpy conversion checks always
 
 
 def test_sequences_become_array_array_and_fixed_arrays_numpy() -> None:
