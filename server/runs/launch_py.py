@@ -57,9 +57,19 @@ def is_python_launch(path: str, text: str | bytes | None = None) -> bool:
     )
 
 
-def frontend_refusal(path: str) -> str | None:
-    """The sentence for a ROS 2 XML or YAML launch file, which is not read."""
-    if path.endswith(ROS2_FRONTEND_SUFFIXES):
+# A ROS 2 XML launch file's node names its program with exec= (ROS 1's with type=); a ROS 2
+# YAML launch file starts with `launch:`.
+_ROS2_XML_NODE = re.compile(r"<node\b[^>]*\bexec\s*=")
+_ROS2_YAML_LAUNCH = re.compile(r"^launch\s*:", re.MULTILINE)
+
+
+def frontend_refusal(path: str, text: str | bytes | None = None) -> str | None:
+    """The sentence for a ROS 2 XML or YAML launch file, which is not read: by its name
+    (.launch.xml, .launch.yaml) or, for .xml/.launch/.yaml names, by what it holds."""
+    body = _text(text) if text is not None else ""
+    ros2_xml = path.endswith((".xml", ".launch")) and _ROS2_XML_NODE.search(body)
+    ros2_yaml = path.endswith((".yaml", ".yml")) and _ROS2_YAML_LAUNCH.search(body)
+    if path.endswith(ROS2_FRONTEND_SUFFIXES) or ros2_xml or ros2_yaml:
         return (
             f"'{path}' is a ROS 2 XML/YAML launch file, which RoboDojo does not read; write it "
             "as a Python launch file (.launch.py with generate_launch_description()) or give "
@@ -77,11 +87,11 @@ def read_launch(
     """Any launch file the lab reads, by its kind: a ROS 2 Python launch file in the sandbox
     (load_python_launch), a ROS 1 .launch/.xml file on the server (server/runs/launch.py, pure
     XML reading); ROS 2 XML/YAML launch files are refused with a sentence."""
-    refusal = frontend_refusal(path)
-    if refusal:
-        raise LaunchFileError(path, None, refusal)
     clean = posixpath.normpath(path)
     text = {posixpath.normpath(k): v for k, v in workspace.items()}.get(clean)
+    refusal = frontend_refusal(clean, text)
+    if refusal:
+        raise LaunchFileError(clean, None, refusal)
     if is_python_launch(clean, text):
         if launcher is None:
             raise ValueError("a Python launch file is read in the sandbox: give a launcher")

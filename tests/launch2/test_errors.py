@@ -151,6 +151,12 @@ def test_ros2_xml_and_yaml_launch_files_are_not_read(launcher):
     files["my_pkg/launch/two.launch.xml"] = "<launch/>\n"
     with pytest.raises(LaunchFileError, match=r"ROS 2 XML/YAML launch file.*\.launch\.py"):
         read_launch("my_pkg/launch/two.launch.xml", files, {}, launcher)
+    # Named as ROS 1 files but written for ROS 2: told apart by what they hold.
+    files["my_pkg/launch/ros2.launch"] = '<launch>\n  <node pkg="my_pkg" exec="talker"/>\n</launch>'
+    files["my_pkg/launch/ros2.yaml"] = "launch:\n- node: {pkg: my_pkg, exec: talker}\n"
+    for name in ("ros2.launch", "ros2.yaml"):
+        with pytest.raises(LaunchFileError, match=r"is a ROS 2 XML/YAML launch file"):
+            read_launch(f"my_pkg/launch/{name}", files, {}, launcher)
     body = (
         "    from launch.actions import IncludeLaunchDescription\n"
         "    return LaunchDescription([IncludeLaunchDescription('my_pkg/launch/two.launch.xml')])\n"
