@@ -13,9 +13,8 @@ type name as its name and genmsg's full concatenated definition as its data, and
 message encoding ``ros1``, so Foxglove decodes the messages without knowing our types. A ROS 2
 run's (``profile="ros2"``) is what ``ros2 bag record`` writes with the MCAP storage plugin:
 ``ros2msg`` schemas, ``cdr`` channels with rosbag2's channel metadata, a ``rosbag2`` metadata
-record and ``metadata.yaml`` beside it; internal service topics stay out (server/runs/rosbag2.py
-says why). A metadata record named ``run`` carries the run id and whatever run information the
-caller passes.
+record and ``metadata.yaml`` beside it (server/runs/rosbag2.py). A metadata record named ``run``
+carries the run id and whatever run information the caller passes.
 
 Off the hot path: ``record()`` appends a tuple to an in-memory list under a lock and returns
 (about a microsecond); a writer thread swaps the list out in batches and writes it (schemas,
@@ -57,7 +56,6 @@ from typing import IO, Any
 from mcap.writer import CompressionType, Writer
 
 from sandbox.msgs import Message, get_message_class
-from sandbox.services import is_internal
 from server.runs import rosbag2
 from server.runs.safe_paths import inside, safe_name, safe_relative_path
 
@@ -259,8 +257,6 @@ class Recorder:
             return
         key = (topic, type_name)
         if key not in self._known:
-            if self._ros2 and is_internal(topic):
-                return  # hidden in ROS 2 and unknown to its tools (server/runs/rosbag2.py)
             self.add_topic(topic, type_name)
         if type(data) is not bytes:
             raise TypeError(f"record() needs the serialized bytes, got {type(data).__name__}")

@@ -17,10 +17,12 @@ QoS: what a ROS 2 recorder sees through discovery - history unknown with depth 0
 announce them), reliable, volatile, infinite deadline, lifespan and lease - except `map`, which
 the map server offers transient-local (a late subscriber still gets it), as Nav2's does.
 
-Our internal service topics (`__srv__/...`) stay out of a ROS 2 recording: ROS 2 names whose token
-starts with "_" are hidden and `ros2 bag record -a` leaves them out, and no ROS 2 tool knows
-robodojo_msgs (ros2 bag play would warn and skip them). Action topics (`.../_action/status`) are
-ordinary ROS 2 messages and stay.
+Our internal service topics (`__srv__/<service>`, `__srv__reply/<node>`: a service's calls, as a
+rosbag2 recording keeps a service's traffic) are written like every other topic, as
+robodojo_msgs/msg/ServiceCall and ServiceReply with their ros2msg schemas: readers decode them
+from the schema (rosbags, mcap-ros2-support), and `ros2 bag play`, which has no robodojo_msgs
+package, warns "Ignoring a topic" and plays the rest. Action topics (`.../_action/status`) are
+ordinary ROS 2 messages, written as rosbag2 writes them with `--include-hidden-topics`.
 """
 
 from __future__ import annotations

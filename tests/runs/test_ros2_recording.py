@@ -58,7 +58,7 @@ def recorded(tmp_path_factory) -> tuple[Run, dict[str, str]]:
     run.builtins.start(run)
     stamped = get_message_class("geometry_msgs/msg/TwistStamped")()
     stamped.twist.linear.x, stamped.twist.angular.z = 0.1, 0.2
-    call = get_message_class("std_msgs/msg/String")(data="a service's request topic")
+    call = get_message_class("robodojo_msgs/msg/ServiceCall")(service="s", reply_to="r", id=1)
     for step in range(1, 31):
         run.advance_to(step * NS // 10)
         run._from_node(
@@ -90,7 +90,7 @@ def test_the_file_is_what_rosbag2_writes(recorded):
         assert profile["deadline"] == {"sec": 9223372036, "nsec": 854775807}
     topics = {channel.topic for channel in summary.channels.values()}
     assert {"/scan", "/odom", "/imu", "/cmd_vel", "/tf", "/goal", "/map", "/pose"} <= topics
-    assert not any("__srv__" in topic for topic in topics)
+    assert "/__srv__/s" in topics  # a service's calls, decodable from their schema
     inside = yaml.safe_load(metadata["rosbag2"]["serialized_metadata"])
     assert inside["version"] == 9 and inside["storage_identifier"] == "mcap"
     assert metadata["run"]["ros_version"] == "2"
@@ -135,6 +135,7 @@ def test_mcap_ros2_decodes_every_message_of_the_file(recorded):
     assert seen["/scan"].range_max > 0
     assert seen["/tf"].transforms[0].child_frame_id == "base_link"
     assert seen["/goal"].pose.position.x == 1.0
+    assert (seen["/__srv__/s"].service, seen["/__srv__/s"].id) == ("s", 1)
 
 
 def test_csv_export_has_ros2_field_names(recorded, tmp_path):
