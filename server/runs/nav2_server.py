@@ -166,7 +166,6 @@ class NavigationServer(BuiltinNode):
         )
         self.follower = PurePursuit()
         self.pose: Pose | None = None
-        self.speed_m_s = 0.0
         self.current: Navigation | None = None
         self.mission: Mission | None = None
         self.subscribes = ("pose",) + ((self.client.reply_topic,) if self.client else ())

@@ -52,7 +52,7 @@ def reply(call: Any, response: Any = None, error: str = "") -> tuple[str, Any]:
     reply_class = get_message_class(SERVICE_REPLY)
     message = reply_class(id=call.id, ok=response is not None, error=error)
     if response is not None:
-        message.response = list(response.serialize())
+        message.response = response.serialize()
     return call.reply_to, message
 
 
@@ -79,7 +79,7 @@ class ServiceClient:
             service=self.service,
             reply_to=self.reply_topic,
             id=call_id,
-            request=list(request.serialize()),
+            request=request.serialize(),
         )
         return call_id, (self.topic, message)
 
