@@ -10,9 +10,11 @@ they become `Outcome.ERROR` with a traceback cut to the student's frames. A brok
 parent raises the link's `ProtocolError`.
 
 What run_node sets up for itself (and undoes on return, so tests can run many nodes in one
-process): sandbox/ros_compat on sys.path, MPLBACKEND=Agg, the `time` patches of a lockstep
-clock, the working directory, sys.argv = [filename, *argv], `__main__`, warnings in their default
-(print-once) form, and a rospy-style root logging handler.
+process): the dialect's compatibility layer on sys.path (sandbox/ros_compat with rospy for a
+ROS 1 node, sandbox/ros_compat2 with rclpy for a ROS 2 one: `NodeInfo.ros_version`),
+MPLBACKEND=Agg, the `time` patches of a lockstep clock, the working directory, sys.argv =
+[filename, *argv], `__main__`, warnings in their default (print-once) form, and a rospy-style
+root logging handler.
 """
 
 from __future__ import annotations
@@ -27,7 +29,7 @@ import warnings
 from contextlib import ExitStack
 from typing import ClassVar, Protocol
 
-from sandbox import ros_imports, runtime
+from sandbox import ros2_imports, ros_imports, runtime
 from sandbox.artifacts import collect_artifacts, write_workspace_files
 from sandbox.limits import DEFAULT_LIMITS, Limits
 from sandbox.protocol import Api, Clock, Exited, Load, NodeError, Outcome
@@ -37,6 +39,7 @@ from sandbox.student_errors import StepError, from_exception, register_source, s
 from sandbox.vclock import NodeClock, TimePatch
 
 ROS_COMPAT_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "ros_compat")
+ROS_COMPAT2_DIR = ros2_imports.ROS_COMPAT2_DIR
 STEP_MODULE_NAME = "controller"  # __name__ of a step-API module, so a __main__ guard stays idle
 
 
@@ -46,16 +49,60 @@ class Link(Protocol):
     def receive(self) -> object: ...
 
 
-def install_ros_compat() -> None:
-    """Make `import rospy` and `from std_msgs.msg import ...` find the shim (idempotent)."""
-    if ROS_COMPAT_DIR not in sys.path:
-        sys.path.insert(0, ROS_COMPAT_DIR)
-    ros_imports.install()  # ROS 1 modules we lack fail with a sentence, not "No module named"
+def _forget_modules_from(directory: str) -> None:
+    """Drop the modules imported from `directory` (the other dialect's layer), so that
+    `std_msgs.msg` means this dialect's package. A sandboxed child runs one node; this matters
+    where one process runs nodes of both dialects in turn (the tests)."""
+    prefix = directory + os.sep
+    for name, module in list(sys.modules.items()):
+        path = getattr(module, "__file__", None) or ""
+        if path.startswith(prefix):
+            del sys.modules[name]
+
+
+def install_ros_compat(ros_version: int = 1) -> None:
+    """Make `import rospy` (ROS 1) or `import rclpy` (ROS 2) and `from std_msgs.msg import ...`
+    find the dialect's layer, and only that one (idempotent)."""
+    ours, other = (
+        (ROS_COMPAT2_DIR, ROS_COMPAT_DIR) if ros_version == 2 else (ROS_COMPAT_DIR, ROS_COMPAT2_DIR)
+    )
+    if other in sys.path:
+        sys.path[:] = [entry for entry in sys.path if entry != other]
+        _forget_modules_from(other)
+    if ours not in sys.path:
+        sys.path.insert(0, ours)
+    # Modules we lack fail with a sentence for this dialect, not "No module named".
+    if ros_version == 2:
+        ros_imports.uninstall()
+        ros2_imports.install()
+    else:
+        ros2_imports.uninstall()
+        ros_imports.install()
+
+
+def imports_rclpy(tree: ast.Module) -> bool:
+    """True when the file imports rclpy (`import rclpy`, `from rclpy.node import Node`...):
+    the node is a ROS 2 node (docs/architecture.md, "Dialects")."""
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            if any(alias.name.split(".")[0] == "rclpy" for alias in node.names):
+                return True
+        elif (
+            isinstance(node, ast.ImportFrom)
+            and node.level == 0
+            and (node.module or "").split(".")[0] == "rclpy"
+        ):
+            return True
+    return False
 
 
 def choose_api(tree: ast.Module, requested: Api) -> Api:
+    """The API a file uses: a top-level `def step` without init_node or rclpy is the step API;
+    anything else runs as a script (rospy or rclpy)."""
     if requested is not Api.AUTO:
         return requested
+    if imports_rclpy(tree):
+        return Api.ROSPY
     defines_step = any(
         isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef) and node.name == "step"
         for node in tree.body
@@ -140,7 +187,7 @@ def _note_figure_saving(stack: ExitStack, node: NodeRuntime) -> None:
 
 def _environment(stack: ExitStack, node: NodeRuntime, load: Load, workdir: str) -> None:
     """Point the interpreter at this node; every change is undone when `stack` closes."""
-    install_ros_compat()
+    install_ros_compat(load.info.ros_version)
     os.environ["MPLBACKEND"] = "Agg"
     if "matplotlib" in sys.modules:
         sys.modules["matplotlib"].use("Agg")

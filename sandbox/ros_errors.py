@@ -1,5 +1,6 @@
 """rospy's exception hierarchy (names and bases as in rospy.exceptions), defined once for the
-node runtime and the rospy shim."""
+node runtime and the rospy shim, and the rclpy exception the node host must recognise
+(rclpy.executors.ExternalShutdownException)."""
 
 from __future__ import annotations
 
@@ -18,3 +19,16 @@ class ROSSerializationException(ROSException):
 
 class ROSInterruptException(ROSException, KeyboardInterrupt):
     """A sleep or wait was interrupted by shutdown."""
+
+
+class ExternalShutdownException(Exception):
+    """rclpy.executors.ExternalShutdownException: the context was shut down while a node was
+    spinning (in ROS 2, what SIGINT or a launch's shutdown does)."""
+
+
+class RunEndedInterrupt(ExternalShutdownException, ROSInterruptException):
+    """What rclpy's waits raise when the run ends the node. A real Ctrl-C makes rclpy.spin
+    raise either KeyboardInterrupt or ExternalShutdownException; this is both, so the cleanup
+    of course code written for either (`except KeyboardInterrupt:`, `except
+    (KeyboardInterrupt, ExternalShutdownException):`) runs, and the host counts it as the
+    parent's shutdown, like rospy's ROSInterruptException."""

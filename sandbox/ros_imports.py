@@ -23,8 +23,24 @@ from sandbox.msgs import _catalog
 _CLI_TOOL = "a command-line tool, not a library a node can use"
 _NO_URDF = "there are no URDF models to parse; the robot's sizes are in the exercise's description"
 
+_ROS2 = (
+    "is part of ROS 2 and this run is ROS 1 (its nodes use rospy, and a run is one or the other)"
+)
+
 # Top-level module -> what to use instead (the sentence ends the error message).
 MISSING_MODULES: dict[str, str] = {
+    "rclpy": (
+        f"{_ROS2}; write this node with rospy, or every node of the run with rclpy (a file "
+        "that imports rclpy runs as ROS 2 when all the run's nodes do)"
+    ),
+    "tf_transformations": f"{_ROS2}; use tf.transformations, which has the same functions",
+    "sensor_msgs_py": (
+        f"{_ROS2}; read sensor_msgs/PointCloud2 with numpy: np.frombuffer(msg.data, dtype)"
+    ),
+    "nav2_simple_commander": f"{_ROS2}; there is no navigation stack in a ROS 1 run",
+    "launch_ros": (
+        "a launch file is given to the run (robodojo run --launch FILE), not imported by a node"
+    ),
     "actionlib": (
         "there are no action servers; use a service (rospy.Service / rospy.ServiceProxy with "
         "std_srvs/Trigger or SetBool) to start a task and topics for its progress"
@@ -193,3 +209,8 @@ def install() -> None:
     """Append the finder to ``sys.meta_path`` (idempotent): it runs after every other finder."""
     if MissingRosModuleFinder not in sys.meta_path:
         sys.meta_path.append(MissingRosModuleFinder)
+
+
+def uninstall() -> None:
+    while MissingRosModuleFinder in sys.meta_path:
+        sys.meta_path.remove(MissingRosModuleFinder)

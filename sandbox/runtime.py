@@ -39,6 +39,7 @@ from sandbox.protocol import (
     Wake,
     Yield,
 )
+from sandbox.ros2_names import BusNames
 from sandbox.ros_errors import (
     ROSException,
     ROSInitException,
@@ -119,8 +120,15 @@ class NodeRuntime:
     _waiting: bool = False
     _main_thread: int = field(default_factory=threading.get_ident)
     busy: BusyLoopModel = field(init=False)
+    # Run after each wake's deliveries and timers, outside callbacks: rclpy runs the
+    # callbacks of executors spinning "in another thread" here (sandbox/ros_compat2/rclpy).
+    after_wake: list[Callable[[], None]] = field(default_factory=list)
+    # More times the node must wake at (rclpy's timers of those executors), besides its own.
+    due_hooks: list[Callable[[], int | None]] = field(default_factory=list)
 
     def __post_init__(self) -> None:
+        if self.names is None and self.info.ros_version == 2:
+            self.names = BusNames()  # rclpy resolves names itself (sandbox.ros2_names)
         if self.names is None:
             try:
                 self.names = Names.from_info(self.info)
@@ -293,6 +301,10 @@ class NodeRuntime:
     ) -> tuple[int | None, list[str] | None]:
         """What to ask the parent for, with timers and services counted in."""
         timer_ns = self.timers.next_due_ns()
+        for hook in self.due_hooks:
+            due_ns = hook()
+            if due_ns is not None:
+                timer_ns = due_ns if timer_ns is None else min(timer_ns, due_ns)
         if wake_at_ns is None and wake_on is None:  # spinning: any message wakes the node
             if timer_ns is None:
                 return None, None
@@ -354,6 +366,9 @@ class NodeRuntime:
                     self._run_student(timer.fire, self.clock.now_ns())
                 if self.shutdown is not None:
                     break
+        if self.shutdown is None:
+            for hook in list(self.after_wake):
+                hook()
         self.outbox.new_burst()  # back in the main loop
         if self.shutdown is not None:  # a callback called signal_shutdown()
             raise ROSInterruptException(f"ROS shutdown request: {self.shutdown.reason}")

@@ -16,7 +16,10 @@ import traceback
 from sandbox.protocol import NodeError
 
 _SANDBOX_DIR = os.path.dirname(os.path.abspath(__file__))
-_ROS_COMPAT_DIR = os.path.join(_SANDBOX_DIR, "ros_compat")
+_ROS_COMPAT_DIRS = (
+    os.path.join(_SANDBOX_DIR, "ros_compat"),  # rospy and the ROS 1 packages
+    os.path.join(_SANDBOX_DIR, "ros_compat2"),  # rclpy and the ROS 2 packages
+)
 # Student-facing libraries of the sandbox outside ros_compat (shared by both ROS versions),
 # named as the student imports them.
 _SHARED_LIBRARIES = {
@@ -80,8 +83,9 @@ def _library_of(path: str) -> str:
         if marker in parts:
             rest = parts[parts.index(marker) + 1 :]
             return rest[0].removesuffix(".py") if rest else marker
-    if path.startswith(_ROS_COMPAT_DIR + os.sep):
-        return os.path.relpath(path, _ROS_COMPAT_DIR).split(os.sep)[0]
+    for compat_dir in _ROS_COMPAT_DIRS:
+        if path.startswith(compat_dir + os.sep):
+            return os.path.relpath(path, compat_dir).split(os.sep)[0]
     for directory, library in _SHARED_LIBRARIES.items():
         if path.startswith(directory + os.sep):
             return library

@@ -22,6 +22,20 @@ from sandbox.services import is_internal
 ANY_TYPE = "*"  # rospy.AnyMsg's type name
 
 
+def is_message_class(data_class: Any) -> bool:
+    """A ROS 1 class (sandbox.msgs.Message) or a ROS 2 one (sandbox.msgs2: `_type`,
+    `serialize`, classmethod `deserialize`)."""
+    if not isinstance(data_class, type):
+        return False
+    if issubclass(data_class, Message):
+        return True
+    return (
+        isinstance(getattr(data_class, "_type", None), str)
+        and callable(getattr(data_class, "serialize", None))
+        and callable(getattr(data_class, "deserialize", None))
+    )
+
+
 class TopicTable:
     def __init__(self, info: NodeInfo, names: Names, warn: Callable[[str], None]) -> None:
         self._error = ROSException
@@ -109,7 +123,7 @@ class TopicTable:
                     "e.g. std_msgs.msg.String"
                 )
             return known
-        if not (isinstance(data_class, type) and issubclass(data_class, Message)):
+        if not is_message_class(data_class):
             raise self._error(
                 f"topic '{name}' needs a message class such as std_msgs.msg.Int32 as its type, "
                 f"got {data_class!r}"

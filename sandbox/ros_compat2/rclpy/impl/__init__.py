@@ -1,0 +1,1 @@
+"""rclpy.impl: here only the logger classes (rcutils_logger, logging_severity)."""
