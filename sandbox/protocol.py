@@ -60,11 +60,20 @@ class Outcome(StrEnum):
 
 class TopicDecl(msgspec.Struct, frozen=True):
     """A topic and its ROS type name, e.g. ("Distance", "std_msgs/Int32"). `latch`: the
-    publisher's last message goes to every later subscriber too (rospy's latch=True)."""
+    publisher's last message goes to every later subscriber too (rospy's latch=True).
+
+    ROS 2 QoS, as far as it changes what a node receives (sandbox/ros_compat2/rclpy/qos.py):
+    `best_effort` - a publisher offers, or a subscription requests, BEST_EFFORT (a RELIABLE
+    subscription gets nothing from a BEST_EFFORT publisher); `latch` on a subscription - it
+    requests TRANSIENT_LOCAL (a VOLATILE publisher does not reach it); `volatile` on a
+    subscription - it takes no latched history (ROS 2's default; rospy's subscribers always do).
+    """
 
     name: str
     type: str
     latch: bool = False
+    best_effort: bool = False
+    volatile: bool = False
 
 
 class RobotTopic(msgspec.Struct, frozen=True):
@@ -106,13 +115,19 @@ class NodeInfo(msgspec.Struct, frozen=True):
     ros_version: int = 1
 
 
-class Envelope(msgspec.Struct, array_like=True, frozen=True):
+class Envelope(msgspec.Struct, array_like=True, frozen=True, omit_defaults=True):
     """One ROS message on a topic: its type name and serialized bytes (ROS1 wire format in a
-    ROS 1 run, CDR with its encapsulation header in a ROS 2 run; NodeInfo.ros_version)."""
+    ROS 1 run, CDR with its encapsulation header in a ROS 2 run; NodeInfo.ros_version).
+
+    On the way to a ROS 2 subscriber the bus may add who published it (when the topic has a
+    BEST_EFFORT publisher) and whether it is a latched topic's history replayed to a late
+    subscriber: each rclpy subscription applies its own QoS with them."""
 
     topic: str
     type: str
     data: bytes
+    publisher: str = ""
+    replayed: bool = False
 
 
 class Artifact(msgspec.Struct, frozen=True):
@@ -142,12 +157,16 @@ class Load(msgspec.Struct, tag=True, frozen=True):
 
 
 class GraphTopic(msgspec.Struct, array_like=True, frozen=True):
-    """One topic of the run's graph as nodes see it (rospy.get_published_topics, services)."""
+    """One topic of the run's graph as nodes see it (rospy.get_published_topics, services).
+    The publishers that offer BEST_EFFORT and those that latch (TRANSIENT_LOCAL) let a ROS 2
+    subscription say which publisher's QoS is incompatible with its own, as rclpy logs it."""
 
     name: str
     type: str
     publishers: list[str]
     subscribers: list[str]
+    best_effort_publishers: list[str] = []
+    latched_publishers: list[str] = []
 
 
 class Wake(msgspec.Struct, tag=True, frozen=True):

@@ -123,6 +123,7 @@ class NodeRuntime:
     # Run after each wake's deliveries and timers, outside callbacks: rclpy runs the
     # callbacks of executors spinning "in another thread" here (sandbox/ros_compat2/rclpy).
     after_wake: list[Callable[[], None]] = field(default_factory=list)
+    delivering: Envelope | None = None  # the envelope whose callbacks run now
     # More times the node must wake at (rclpy's timers of those executors), besides its own.
     due_hooks: list[Callable[[], int | None]] = field(default_factory=list)
 
@@ -151,9 +152,11 @@ class NodeRuntime:
             )
 
     # The run's topic names and types this node knows (sandbox.topic_table).
-    def advertise(self, topic: str, data_class: Any, latch: bool = False) -> str:
+    def advertise(
+        self, topic: str, data_class: Any, latch: bool = False, best_effort: bool = False
+    ) -> str:
         """Check that this node may publish `data_class` on `topic`; return the bus name."""
-        return self.topics.advertise(topic, data_class, latch)
+        return self.topics.advertise(topic, data_class, latch, best_effort)
 
     def bus_name(self, topic: Any) -> str:
         return self.topics.bus_name(topic)
@@ -177,8 +180,10 @@ class NodeRuntime:
         callback: Callable[..., Any] | None,
         args: Any = None,
         queue_size: int | None = None,
+        **qos: bool,
     ) -> Subscription:
-        name = self.topics.subscribe(topic, data_class)
+        """`qos`: a ROS 2 subscription's best_effort, transient_local, volatile."""
+        name = self.topics.subscribe(topic, data_class, **qos)
         subscription = Subscription(name, data_class, callback, args, queue_size)
         self._subscribers.setdefault(name, []).append(subscription)
         return subscription
@@ -394,6 +399,7 @@ class NodeRuntime:
             seen[topic] = index = seen.get(topic, 0) + 1
             newer = counts[topic] - index  # messages of this topic still to come in this wake
             decoded: dict[type, Message] = {}
+            self.delivering = envelope  # rclpy's subscriptions read its QoS marks
             for subscription in list(self._subscribers.get(topic, ())):
                 if self.shutdown is not None:
                     return

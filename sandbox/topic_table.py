@@ -138,9 +138,12 @@ class TopicTable:
         return type_name
 
     # ------------------------------------------------------------------ declarations
-    def advertise(self, topic: Any, data_class: Any, latch: bool = False) -> str:
+    def advertise(
+        self, topic: Any, data_class: Any, latch: bool = False, best_effort: bool = False
+    ) -> str:
         """Check that this node may publish `data_class` on `topic`; return the bus name.
-        `latch`: later subscribers get the last message too (rospy's latch=True)."""
+        `latch`: later subscribers get the last message too (rospy's latch=True);
+        `best_effort`: a ROS 2 publisher offering BEST_EFFORT (sandbox.protocol.TopicDecl)."""
         # Hot path: the step API and many scripts publish the same topic every period.
         checked = self._checked.get((topic, data_class))
         if checked is not None:
@@ -157,9 +160,9 @@ class TopicTable:
         self.types[name] = type_name
         if name not in self.advertised:
             self.advertised.add(name)
-            self._new_advertised.append(TopicDecl(name, type_name, latch))
+            self._new_advertised.append(TopicDecl(name, type_name, latch, best_effort))
         elif latch and name not in self._latched:
-            self._new_advertised.append(TopicDecl(name, type_name, latch))
+            self._new_advertised.append(TopicDecl(name, type_name, latch, best_effort))
         if latch:
             self._latched.add(name)
             return name  # not cached: the plain entry must not hide a later latch
@@ -167,8 +170,18 @@ class TopicTable:
             self._checked[(topic, data_class)] = name
         return name
 
-    def subscribe(self, topic: Any, data_class: Any) -> str:
-        """Check a subscription of `data_class` to `topic`; return the bus name."""
+    def subscribe(
+        self,
+        topic: Any,
+        data_class: Any,
+        *,
+        best_effort: bool = False,
+        transient_local: bool = False,
+        volatile: bool = False,
+    ) -> str:
+        """Check a subscription of `data_class` to `topic`; return the bus name. The keywords
+        are a ROS 2 subscription's QoS (sandbox.protocol.TopicDecl); the first subscription
+        of a topic in the node declares them."""
         name = self.bus_name(topic)
         type_name = self._check_type(name, data_class)
         if name not in self.types:
@@ -178,7 +191,9 @@ class TopicTable:
         self.types[name] = type_name
         if name not in self.subscribed:
             self.subscribed.add(name)
-            self._new_subscribed.append(TopicDecl(name, type_name))
+            self._new_subscribed.append(
+                TopicDecl(name, type_name, transient_local, best_effort, volatile)
+            )
             if name in self._unsubscribed:
                 self._unsubscribed.remove(name)
         return name

@@ -11,6 +11,8 @@ from __future__ import annotations
 from collections import deque
 from dataclasses import dataclass, field
 
+import msgspec
+
 from sandbox.protocol import Envelope, GraphTopic, TopicDecl
 
 QUEUE_SIZE = 100  # [messages] per topic per subscriber between two wakes
@@ -32,6 +34,11 @@ class _Topic:
     # TwistStamped): each subscriber gets only messages of the type it subscribed with.
     mixed: bool = False
     subscriber_types: dict[str, str] = field(default_factory=dict)
+    # ROS 2 QoS (sandbox.protocol.TopicDecl): publishers offering BEST_EFFORT, and the ROS 2
+    # subscribers, whose deliveries say which publisher sent them and whether they are a
+    # latched topic's history (a RELIABLE or a VOLATILE subscription drops those itself).
+    best_effort_by: set[str] = field(default_factory=set)
+    ros2_subscribers: set[str] = field(default_factory=set)
 
     def rate_hz(self) -> float | None:
         if len(self.recent) < 2 or self.recent[-1] <= self.recent[0]:
@@ -99,10 +106,16 @@ class TopicBus:
             self.declare_topic(decl.name, decl.type, node)
             if decl.latch:
                 self.topics[decl.name].latched_by.add(node)
+            if decl.best_effort:
+                self.topics[decl.name].best_effort_by.add(node)
+                self.version += 1
         for decl in subscribed:
             self.declare_topic(decl.name, decl.type)
             topic = self.topics[decl.name]
             topic.subscribers.add(node)
+            ros2 = decl.volatile or decl.latch or decl.best_effort
+            if ros2:
+                topic.ros2_subscribers.add(node)
             if topic.mixed:
                 topic.subscriber_types[node] = decl.type
             queue = self._inboxes[node].queues.setdefault(decl.name, deque(maxlen=QUEUE_SIZE))
@@ -110,6 +123,10 @@ class TopicBus:
             # A latched topic's last message reaches a subscriber that comes late (rospy).
             for publisher, (time_s, envelope) in sorted(topic.latched.items()):
                 if publisher != node and (not topic.mixed or envelope.type == decl.type):
+                    if ros2:
+                        envelope = msgspec.structs.replace(
+                            envelope, publisher=publisher, replayed=True
+                        )
                     self._enqueue(self._inboxes[node], queue, time_s, envelope)
 
     def unsubscribe(self, node: str, names: list[str]) -> None:
@@ -119,6 +136,7 @@ class TopicBus:
             topic = self.topics.get(name)
             if topic is not None:
                 topic.subscribers.discard(node)
+                topic.ros2_subscribers.discard(node)
             queue = inbox.queues.pop(name, None)
             if queue:
                 inbox.pending -= len(queue)
@@ -150,6 +168,8 @@ class TopicBus:
                 topic.type,
                 sorted(topic.publishers - ended),
                 sorted(topic.subscribers - ended),
+                sorted(topic.best_effort_by - ended),
+                sorted(topic.latched_by - ended),
             )
             for name, topic in sorted(self.topics.items())
         ]
@@ -173,6 +193,9 @@ class TopicBus:
         topic.count += 1
         topic.recent.append(time_s)
         self._seq += 1
+        stamped = envelope
+        if topic.best_effort_by:  # ROS 2 subscribers need to know who sent it
+            stamped = msgspec.structs.replace(envelope, publisher=publisher)
         for name in topic.subscribers:
             if name == publisher or name in self._ended:
                 continue
@@ -181,7 +204,8 @@ class TopicBus:
             inbox = self._inboxes[name]
             queue = inbox.queues.get(envelope.topic)
             if queue is not None:  # None: a built-in listener (declare_listener)
-                self._enqueue(inbox, queue, time_s, envelope, self._seq)
+                delivered = stamped if name in topic.ros2_subscribers else envelope
+                self._enqueue(inbox, queue, time_s, delivered, self._seq)
 
     def _enqueue(
         self, inbox: _Inbox, queue: deque, time_s: float, envelope: Envelope, seq: int = 0

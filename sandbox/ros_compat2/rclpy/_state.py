@@ -48,7 +48,9 @@ class ProcessState:
         self.run_ended = False  # the run ended the node (Shutdown from the parent)
         self._running_background = False
         self.main_thread = node_runtime._main_thread
+        node_runtime.after_wake.append(self._check_graph_qos)
         node_runtime.after_wake.append(self._run_background)
+        self._graph_seen: object = None
         node_runtime.due_hooks.append(self._background_due_ns)
         node_runtime.on_shutdown(self._on_runtime_shutdown)
 
@@ -78,6 +80,20 @@ class ProcessState:
                 executor._run_ready_in_background()
         finally:
             self._running_background = False
+
+    def _check_graph_qos(self) -> None:
+        """A new graph: subscriptions warn of incompatible publishers in other nodes."""
+        graph = self.runtime.graph
+        if graph is None or graph is self._graph_seen:
+            return
+        self._graph_seen = graph
+        by_name = {topic.name: topic for topic in graph}
+        own_label = self.runtime.info.node_name
+        for node in self.nodes:
+            for subscription in node._subscriptions:
+                topic = by_name.get(subscription._bus_topic)
+                if topic is not None:
+                    subscription._check_graph(topic, own_label)
 
     def _on_runtime_shutdown(self) -> None:
         for context in list(self.contexts):

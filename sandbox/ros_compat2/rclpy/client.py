@@ -186,6 +186,8 @@ class Client:
                 if work is not None:
                     nested_executor._execute(work)
                     continue
+            elif self._serve_locally():
+                continue
             now = _state.now_ns()
             if deadline_ns is not None and now >= deadline_ns:
                 self.remove_pending_request(future)
@@ -211,6 +213,19 @@ class Client:
         if exception is not None:
             raise exception
         return future.result()
+
+    def _serve_locally(self) -> bool:
+        """From the main loop, a service of this process answers at once, as the spin thread
+        a ROS 2 program of that shape runs would answer it (with nothing spinning, rclpy would
+        wait for ever). True if it ran."""
+        local = self._local_service()
+        if local is None or not local._ready():
+            return False
+        call = local._take()
+        if call is not None:
+            with _state.state().executing_callback(local.callback_group):
+                call()
+        return True
 
     def get_pending_request(self, sequence_number: int) -> Future[Any]:
         return self._pending_requests[sequence_number]

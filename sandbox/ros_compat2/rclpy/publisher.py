@@ -40,7 +40,7 @@ class Publisher:
         self.reliability = qos_profile.effective_reliability()
         self.durability = qos_profile.effective_durability()
         latch = self.durability == DurabilityPolicy.TRANSIENT_LOCAL
-        _state.runtime().advertise(bus_topic, msg_type, latch=latch)
+        _state.runtime().advertise(bus_topic, msg_type, latch=latch, best_effort=self.best_effort)
 
     @property
     def handle(self) -> Publisher:

@@ -16,7 +16,13 @@ from typing import TYPE_CHECKING, Any
 
 from . import _state
 from .exceptions import InvalidHandle
-from .qos import DurabilityPolicy, QoSProfile, qos_policy_name_from_kind
+from .qos import (
+    DurabilityPolicy,
+    QoSPolicyKind,
+    QoSProfile,
+    ReliabilityPolicy,
+    qos_policy_name_from_kind,
+)
 
 if TYPE_CHECKING:
     from .callback_groups import CallbackGroup
@@ -53,7 +59,15 @@ class Subscription:
         self._received = 0
         self._destroyed = False
         self._warned_publishers: set[str] = set()
-        self._runtime_subscription = _state.runtime().subscribe(bus_topic, msg_type, self._arrived)
+        self._reliable = qos_profile.effective_reliability() == ReliabilityPolicy.RELIABLE
+        self._runtime_subscription = _state.runtime().subscribe(
+            bus_topic,
+            msg_type,
+            self._arrived,
+            best_effort=qos_profile.effective_reliability() == ReliabilityPolicy.BEST_EFFORT,
+            transient_local=self.transient_local,
+            volatile=not self.transient_local,
+        )
 
     @property
     def handle(self) -> Subscription:
@@ -112,7 +126,20 @@ class Subscription:
 
     # ------------------------------------------------------------------ arrivals
     def _arrived(self, message: Any) -> None:
-        """A message from the run's bus (decoded by the runtime)."""
+        """A message from the run's bus (decoded by the runtime), unless this subscription's
+        QoS keeps it out: a latched topic's history reaches only a TRANSIENT_LOCAL
+        subscription, and a BEST_EFFORT publisher's messages do not reach a RELIABLE one."""
+        node_runtime = _state.runtime()
+        envelope = node_runtime.delivering
+        if envelope is not None:
+            if envelope.replayed and not self.transient_local:
+                return
+            if envelope.publisher and self._reliable:
+                graph = {topic.name: topic for topic in node_runtime.graph or ()}
+                topic = graph.get(self._bus_topic)
+                if topic is not None and envelope.publisher in topic.best_effort_publishers:
+                    self._warn_incompatible(envelope.publisher, QoSPolicyKind.RELIABILITY)
+                    return
         self._put(message)
 
     def _put(self, message: Any) -> None:
@@ -137,6 +164,17 @@ class Subscription:
             "No messages will be received from it. Last incompatible policy: "
             f"{qos_policy_name_from_kind(policy_kind)}"
         )
+
+    def _check_graph(self, topic: Any, own_label: str) -> None:
+        """The run's graph changed: warn about other nodes' publishers whose QoS keeps their
+        messages from this subscription (the run's bus does not deliver them)."""
+        for publisher in topic.publishers:
+            if publisher == own_label:
+                continue
+            if self._reliable and publisher in topic.best_effort_publishers:
+                self._warn_incompatible(publisher, QoSPolicyKind.RELIABILITY)
+            elif self.transient_local and publisher not in topic.latched_publishers:
+                self._warn_incompatible(publisher, QoSPolicyKind.DURABILITY)
 
     # ------------------------------------------------------------------ executor side
     def _ready(self) -> bool:
