@@ -251,7 +251,6 @@ CASES = (
         4.5,
         checks.check_ir_scout,
         nodes=(Node("ir_scout_node.py"),),
-        needs=(CHECK_REVIEW,),
     ),
     ros2_case(
         "crop_rover_node",
