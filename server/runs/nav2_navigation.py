@@ -4,7 +4,9 @@ feedback, as Nav2's planner server, controller server and bt_navigator share the
 - Plan: A* over the map grown by the robot's radius (server/runs/builtin.py, the `planner`
   built-in's search), from the localized pose to the goal, once per goal. The path's last pose
   is the goal itself; each pose faces the next (NavFn gives positions, the last pose the goal's
-  orientation). Nav2's default behaviour tree replans at 1 Hz; here the plan stays, as the
+  orientation). Or, as the thesis plans for its Stanley controller, Hybrid A* (nav2_hybrid.py,
+  like Nav2's SMAC Hybrid-A* planner): arcs of a minimum turning radius ending in the goal's
+  heading. Nav2's default behaviour tree replans at 1 Hz; here the plan stays, as the
   ROS 1 exercise's planner does, so both dialects grade the same path.
 - Control: each control period the goal checker, the progress checker, then a command: from the
   built-in follower (nav2_follow.PurePursuit) or, in the thesis's form (003_4f92d1fa0a49ddae.txt
@@ -28,7 +30,9 @@ from server.runs.nav2_follow import (
     closest_index,
     estimated_time_s,
     path_length_from,
+    wrap,
 )
+from server.runs.nav2_hybrid import SAMPLE_M, STEP_M, grid_distance, hybrid_astar
 
 Pose = tuple[float, float, float]  # x [m], y [m], yaw [rad] in the map frame
 
@@ -48,9 +52,16 @@ def yaw_of(orientation: Any) -> float:
     return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
 
 
-def plan_path(planner: Any, start: Pose, goal: Pose) -> np.ndarray:
-    """(n, 2) path of cell centres from `start` to `goal` (exactly), by A* on the planner's
-    grown grid. NoPath with a sentence when the goal cannot be reached."""
+PLANNERS = ("astar", "hybrid_astar")  # NavFn-like on the grid; SMAC Hybrid-A*-like
+
+
+def plan_path(
+    planner: Any, start: Pose, goal: Pose, kind: str = "astar", radius_m: float = 0.4
+) -> tuple[np.ndarray, np.ndarray]:
+    """((n, 2) positions, (n,) headings) of a path from `start` to exactly `goal` on the
+    planner's grown grid: A* through cell centres (headings towards the next pose, the last the
+    goal's), or Hybrid A* for a car of turning radius `radius_m` (arriving with the goal's
+    heading). NoPath with a sentence when the goal cannot be reached."""
     grid = planner.grid
     inside = (
         grid.origin_x <= goal[0] < grid.origin_x + grid.width * grid.resolution
@@ -68,16 +79,54 @@ def plan_path(planner: Any, start: Pose, goal: Pose) -> np.ndarray:
             "choose a goal in free space",
             "GOAL_OCCUPIED",
         )
+    unreachable = (
+        f"no path leads from ({start[0]:.2f}, {start[1]:.2f}) to the goal {where}: "
+        "it is in a closed-off part of the map"
+    )
+    if kind == "hybrid_astar":
+        return _hybrid(planner, start, goal, radius_m, unreachable)
     cells = astar(planner.blocked, planner._cell(start[0], start[1]), goal_cell)
     if not cells:
-        raise NoPath(
-            f"no path leads from ({start[0]:.2f}, {start[1]:.2f}) to the goal {where}: "
-            "it is in a closed-off part of the map",
-            "NO_VALID_PATH",
-        )
+        raise NoPath(unreachable, "NO_VALID_PATH")
     points = np.array([planner._centre(row, col) for row, col in cells], dtype=float)
     points[-1] = goal[:2]
-    return points
+    return points, path_yaws(points, goal[2])
+
+
+def _hybrid(planner: Any, start: Pose, goal: Pose, radius_m: float, unreachable: str) -> tuple:
+    grid, blocked = planner.grid, planner.blocked
+    distance = grid_distance(blocked, planner._cell(goal[0], goal[1]), grid.resolution)
+
+    def cell(x: float, y: float) -> tuple[int, int] | None:
+        col = math.floor((x - grid.origin_x) / grid.resolution)
+        row = math.floor((y - grid.origin_y) / grid.resolution)
+        return (row, col) if 0 <= row < grid.height and 0 <= col < grid.width else None
+
+    def free(x: float, y: float) -> bool:
+        # a robot parked against a grown obstacle may still leave the way it came
+        near_start = math.hypot(x - start[0], y - start[1]) < STEP_M
+        where = cell(x, y)
+        return where is not None and (near_start or not blocked[where])
+
+    def to_goal(x: float, y: float) -> float:
+        where = cell(x, y)
+        return math.inf if where is None else float(distance[where])
+
+    if not math.isfinite(to_goal(start[0], start[1])) and not blocked[planner._cell(*start[:2])]:
+        raise NoPath(unreachable, "NO_VALID_PATH")
+    poses = hybrid_astar(start, goal, free, to_goal, grid.resolution, radius_m)
+    if not poses:
+        raise NoPath(
+            f"no path with turns of at least {radius_m} m radius leads from "
+            f"({start[0]:.2f}, {start[1]:.2f}) to the goal ({goal[0]:.2f}, {goal[1]:.2f}); "
+            "a goal further from walls and doors, or the astar planner, may do",
+            "NO_VALID_PATH",
+        )
+    # one pose per map cell of travel, as SMAC gives its path at the costmap's resolution
+    every = max(1, round(grid.resolution / SAMPLE_M))
+    kept = [*poses[::every][:-1], poses[-1]] if len(poses) > every else poses
+    path = np.array([start, *kept], dtype=float)
+    return path[:, :2].copy(), np.array([wrap(yaw) for yaw in path[:, 2]])
 
 
 def path_yaws(points: np.ndarray, goal_yaw: float) -> np.ndarray:

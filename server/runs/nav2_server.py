@@ -18,7 +18,9 @@ waypoint when one fails.
 Parameters (the run's params): `controller_frequency` [Hz] (Nav2's default 20), `controller_service`
 (a service a student node serves, robodojo_msgs/srv/ComputeVelocityCommands: the thesis's
 Stanley controller, 003_4f92d1fa0a49ddae.txt section 5.9; unset: the built-in follower),
-`xy_goal_tolerance` [m], `yaw_goal_tolerance` [rad] (Nav2's 0.25 and 0.25), `stop_on_failure`.
+`xy_goal_tolerance` [m], `yaw_goal_tolerance` [rad] (Nav2's 0.25 and 0.25), `stop_on_failure`,
+`planner` ("astar", NavFn-like, or "hybrid_astar", SMAC Hybrid-A*-like, as the thesis plans for
+its Stanley controller) and `minimum_turning_radius` [m] (SMAC's 0.4).
 """
 
 from __future__ import annotations
@@ -32,7 +34,7 @@ from sandbox.runtime import format_log_line
 from sandbox.services import request_topic
 from server.runs.builtin import BuiltinNode, Planner
 from server.runs.nav2_follow import GoalChecker, PurePursuit
-from server.runs.nav2_navigation import Navigation, NoPath, Pose, path_yaws, plan_path, yaw_of
+from server.runs.nav2_navigation import PLANNERS, Navigation, NoPath, Pose, plan_path, yaw_of
 from server.runs.nav2_wire import (
     SERVICE_CALL,
     ActionWire,
@@ -50,6 +52,7 @@ NS = 1_000_000_000
 CONTROLLER_FREQUENCY_HZ = 20.0  # [Hz] Nav2's controller_server default
 SERVICE_PATIENCE_S = 1.0  # [s] a goal waits this long for an unserved controller service
 WAYPOINT_PAUSE_S = 0.2  # [s] WaitAtWaypoint's waypoint_pause_duration default (200 ms)
+TURNING_RADIUS_M = 0.4  # [m] SMAC Hybrid-A*'s minimum_turning_radius default
 CONTROLLER_SERVICE_TYPE = "robodojo_msgs/srv/ComputeVelocityCommands"
 NAVIGATE = "navigate_to_pose"
 FOLLOW = "follow_waypoints"
@@ -153,6 +156,12 @@ class NavigationServer(BuiltinNode):
         self.xy_tol = float(params.get("xy_goal_tolerance", GoalChecker.xy_tolerance_m))
         self.yaw_tol = float(params.get("yaw_goal_tolerance", GoalChecker.yaw_tolerance_rad))
         self.stop_on_failure = bool(params.get("stop_on_failure", True))
+        self.planner_kind = str(params.get("planner", "astar"))
+        if self.planner_kind not in PLANNERS:
+            raise ValueError(
+                f"planner '{self.planner_kind}' is unknown; use one of {', '.join(PLANNERS)}"
+            )
+        self.turning_radius_m = float(params.get("minimum_turning_radius", TURNING_RADIUS_M))
         self.navigate = ActionWire(NAVIGATE, get_action_class("nav2_msgs/action/NavigateToPose"))
         self.follow = ActionWire(FOLLOW, get_action_class("nav2_msgs/action/FollowWaypoints"))
         self.compute = ActionWire(
@@ -223,22 +232,23 @@ class NavigationServer(BuiltinNode):
         try:
             if (begin or self.pose) is None:
                 raise NoPath("no pose from the localization yet", "TF_ERROR")
-            points = plan_path(
-                self.planner, begin or self.pose, (end.position.x, end.position.y, 0.0)
-            )
+            target = (end.position.x, end.position.y, yaw_of(end.orientation))
+            points, yaws = self._plan(begin or self.pose, target)
         except NoPath as error:
             code = "PLANNER_TF_ERROR" if error.code == "TF_ERROR" else error.code
             _with_error(result, code, str(error))
             return self._end(run, self.compute, goal, GoalEvent.ABORT, result, str(error))
-        result.path = self._path_message(points, yaw_of(end.orientation), run.time_ns)
+        result.path = self._path_message(points, yaws, run.time_ns)
         return self._end(run, self.compute, goal, GoalEvent.SUCCEED, result)
 
-    def _path_message(self, points: Any, goal_yaw: float, time_ns: int) -> Any:
+    def _plan(self, start: Pose, goal: Pose) -> tuple[Any, Any]:
+        return plan_path(self.planner, start, goal, self.planner_kind, self.turning_radius_m)
+
+    def _path_message(self, points: Any, yaws: Any, time_ns: int) -> Any:
         path = _msg("nav_msgs/msg/Path")
         path.header = _msg("std_msgs/msg/Header", stamp=time_msg(time_ns), frame_id="map")
         path.poses = [
-            _pose_stamped(x, y, yaw, time_ns)
-            for (x, y), yaw in zip(points, path_yaws(points, goal_yaw), strict=True)
+            _pose_stamped(x, y, yaw, time_ns) for (x, y), yaw in zip(points, yaws, strict=True)
         ]
         return path
 
@@ -304,7 +314,7 @@ class NavigationServer(BuiltinNode):
         pose = target.pose
         end = (pose.position.x, pose.position.y, yaw_of(pose.orientation))
         try:
-            points = plan_path(self.planner, self.pose, end)
+            points, yaws = self._plan(self.pose, end)
         except NoPath as error:
             self.log(run, "WARN", f"navigate_to_pose: {error}")
             return out + self._abort_now(run, goal, error.code, str(error))
@@ -312,7 +322,7 @@ class NavigationServer(BuiltinNode):
             goal.uuid, end, points, run.time_ns, GoalChecker(self.xy_tol, self.yaw_tol)
         )
         self.follower.reset()
-        path = self._path_message(points, end[2], run.time_ns)
+        path = self._path_message(points, yaws, run.time_ns)
         self.path_message = path
         self.log(run, "INFO", f"navigate_to_pose: heading to ({end[0]:.2f}, {end[1]:.2f})")
         return [*out, ("plan", path)]

@@ -15,7 +15,7 @@ from server.runs.nav2_follow import (
     estimated_time_s,
     path_length_from,
 )
-from server.runs.nav2_navigation import NoPath, path_yaws, plan_path
+from server.runs.nav2_navigation import NoPath, plan_path
 
 
 def test_goal_checker_is_stateful_about_xy_and_strict_about_yaw():
@@ -107,10 +107,9 @@ def test_plans_end_at_the_goal_and_unreachable_goals_are_sentences():
     blocked[:, 5] = True
     blocked[9, 5] = False  # a gap at the top
     planner = GridPlanner(blocked)
-    points = plan_path(planner, (0.15, 0.15, 0.0), (0.83, 0.21, 1.0))
+    points, yaws = plan_path(planner, (0.15, 0.15, 0.0), (0.83, 0.21, 1.0))
     assert tuple(points[-1]) == (0.83, 0.21) and tuple(points[0]) == pytest.approx((0.15, 0.15))
     assert max(points[:, 1]) > 0.9  # through the gap
-    yaws = path_yaws(points, 1.0)
     step = points[1] - points[0]
     assert yaws[-1] == 1.0 and yaws[0] == pytest.approx(math.atan2(step[1], step[0]))
     with pytest.raises(NoPath, match=r"the goal \(0.55, 0.35\) is in or too close to an obstacle"):
