@@ -423,6 +423,12 @@ class NodeRuntime:
 
     # ------------------------------------------------------------------ logging
     def log(self, level_name: str, text: str) -> None:
+        if self.info.ros_version == 2:  # as rclpy prints: [WARN] [1.500000000] [node]: text
+            seconds, nanoseconds = divmod(self.clock.now_ns(), 1_000_000_000)
+            name = (self.node_name or self.info.node_name).strip("/").replace("/", ".")
+            line = f"[{level_name}] [{seconds}.{nanoseconds:09d}] [{name}]: {text}"
+            print(line, flush=True)
+            return
         print(format_log_line(level_name, self.clock.now_ns() / 1e9, text), flush=True)
 
     def warn(self, text: str) -> None:

@@ -207,14 +207,6 @@ class Rate:
         if self._timer._destroyed:
             self.destroy()
             raise InvalidHandle("Rate cannot sleep because the timer has been destroyed")
-        current = _state.state()
-        if not current.background and current.on_node_thread():
-            current.warn_once(
-                "rate_without_spin",
-                "Rate.sleep() works here without spinning, but in ROS 2 it returns only while "
-                "the node is spun in another thread, e.g. threading.Thread(target=rclpy.spin, "
-                "args=(node,), daemon=True).start()",
-            )
         target = self._timer._next_call_ns
         if _state.now_ns() >= target:
             self._timer._take()  # the tick passed while the loop worked: return at once, as
@@ -226,3 +218,11 @@ class Rate:
             self._is_shutdown = True
             raise _RateInterrupted()
         self._timer._take()
+        current = _state.state()  # looked at after a sleep: a spin thread has started by now
+        if not current.background and current.on_node_thread():
+            current.warn_once(
+                "rate_without_spin",
+                "Rate.sleep() works here without spinning, but in ROS 2 it returns only while "
+                "the node is spun in another thread, e.g. threading.Thread(target=rclpy.spin, "
+                "args=(node,), daemon=True).start()",
+            )
