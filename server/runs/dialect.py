@@ -29,7 +29,6 @@ from sandbox.protocol import Envelope
 
 TWIST = "geometry_msgs/Twist"
 TWIST_STAMPED = "geometry_msgs/TwistStamped"
-NS = 1_000_000_000
 
 
 class Dialect:

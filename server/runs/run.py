@@ -182,7 +182,7 @@ class Run(RunControls, RunOutputs):
         )
         for topic in self.sim.topics:
             type_name = dialect.type_name(topic.type_name)
-            if len(dialect.accepted_types(topic.type_name)) > 1:  # Twist or TwistStamped
+            if dialect.command_types(topic.type_name, topic.direction):  # Twist, TwistStamped
                 self.bus.allow_types(topic.name, type_name)  # recorded in the type sent
                 continue
             self.bus.declare_topic(topic.name, type_name, ROBOT if topic.rate_hz else None)
