@@ -243,3 +243,66 @@ def test_init_twice_fails_as_rclpy_does(tmp_path: Path) -> None:
     assert exited.error.type == "RuntimeError"
     assert exited.error.message == "Context.init() must only be called once"
     assert isinstance(exited, Exited)
+
+
+def test_async_callbacks_await_a_service_response(tmp_path: Path) -> None:
+    code = """
+import rclpy
+from example_interfaces.srv import AddTwoInts
+from rclpy.node import Node
+from std_msgs.msg import Int64
+
+rclpy.init()
+node = Node('asker')
+
+def add(request, response):
+    response.sum = request.a + request.b
+    return response
+
+node.create_service(AddTwoInts, 'add', add)
+client = node.create_client(AddTwoInts, 'add')
+out = node.create_publisher(Int64, 'sum', 10)
+
+async def tick():
+    response = await client.call_async(AddTwoInts.Request(a=40, b=2))
+    out.publish(Int64(data=response.sum))
+    rclpy.shutdown()
+
+node.create_timer(0.1, tick)
+rclpy.spin(node)
+"""
+    yields, exited, _ = run(code, tmp_path, name="asker")
+    assert exited.outcome is Outcome.FINISHED, exited.error
+    assert [m.data for m in published(yields, exited, "sum")] == [42]
+
+
+def test_spin_once_serves_each_ready_subscription_before_serving_one_twice(
+    tmp_path: Path,
+) -> None:
+    code = """
+import rclpy
+from rclpy.node import Node
+from std_msgs.msg import Bool, Int32, String
+
+rclpy.init()
+node = Node('fair')
+order = []
+node.create_subscription(Int32, 'Distance', lambda m: order.append('d'), 10)
+node.create_subscription(Bool, 'Button', lambda m: order.append('b'), 10)
+rclpy.spin_once(node, timeout_sec=0.2)  # waits for the first burst, serves one
+for _ in range(3):
+    rclpy.spin_once(node, timeout_sec=0)
+node.create_publisher(String, 'order', 10).publish(String(data=''.join(order)))
+"""
+
+    def sensors(time_s: float) -> list:
+        return [
+            envelope("Distance", message("std_msgs/msg/Int32", data=1)),
+            envelope("Distance", message("std_msgs/msg/Int32", data=2)),
+            envelope("Button", message("std_msgs/msg/Bool", data=True)),
+            envelope("Button", message("std_msgs/msg/Bool", data=False)),
+        ]
+
+    yields, exited, _ = run(code, tmp_path, sensors, name="fair")
+    assert exited.outcome is Outcome.FINISHED, exited.error
+    assert [m.data for m in published(yields, exited, "order")] == ["dbdb"]

@@ -110,9 +110,8 @@ class Executor:
             self._nodes.remove(node)
             if node._executor is self:
                 node._executor = None
-            self._snapshot = [
-                (entity, owner) for entity, owner in self._snapshot if owner is not node
-            ]
+            # The node's entries stay in the pass: rclpy.spin_once(node) adds and removes the
+            # node each call, and its next call serves what this pass had not served yet.
             _state.state().refresh_wake_topics()
 
     def wake(self) -> None:
@@ -256,7 +255,9 @@ class Executor:
                     if entity.ready():
                         return (entity, entity, None)
                     continue
-                if node not in self._nodes or not entity._ready() or not _group_allows(entity):
+                if node not in self._nodes:
+                    continue  # dropped from the pass: the node left the executor
+                if not entity._ready() or not _group_allows(entity):
                     continue
                 call = entity._take()
                 if call is not None:
