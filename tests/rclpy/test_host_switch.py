@@ -70,3 +70,12 @@ def test_a_file_importing_rclpy_is_a_script_even_with_a_step_function() -> None:
     assert choose_api(tree, Api.AUTO) is Api.ROSPY
     plain = ast.parse("def step(obs):\n    return {}\n")
     assert choose_api(plain, Api.AUTO) is Api.STEP
+
+
+def test_rclpy_modules_we_leave_out_say_so(launcher) -> None:
+    exited = run_sandboxed(launcher, "import rclpy\nimport rclpy.lifecycle\n", ros2_info("lc"))
+    assert exited.outcome is Outcome.ERROR
+    assert exited.error.message == (
+        "rclpy.lifecycle is not available in RoboDojo: lifecycle (managed) nodes are not "
+        "provided; use a plain rclpy.node.Node"
+    )
