@@ -3,7 +3,8 @@ and JSON documents such as the metrics.
 
 Layout of ``out_dir``::
 
-    recording.mcap               every message, ROS1-encoded, one channel per topic ("/scan")
+    recording.mcap               every message, one channel per topic ("/scan")
+    metadata.yaml                a ROS 2 run's bag metadata, as rosbag2 writes it
     logs/<node>.log              what each node printed, appended as it arrives
     artifacts/<node>/<name>      files a node saved
     <name>.json                  write_json("metrics", ...) -> metrics.json
@@ -249,7 +250,8 @@ class Recorder:
 
     # ----------------------------------------------------------------------------- hot path
     def record(self, topic: str, type_name: str, log_time_ns: int, data: bytes) -> None:
-        """Queue one ROS1-serialized message published at run time `log_time_ns` [ns].
+        """Queue one serialized message (ROS 1 bytes, or CDR in a ROS 2 recording) published
+        at run time `log_time_ns` [ns].
 
         Returns at once unless the writer is `max_buffer_bytes` behind (then it waits); a no-op
         once the recorder has failed."""

@@ -274,7 +274,7 @@ def _run_file(record: RunRecord, relative: str) -> Path:
     return path
 
 
-@router.get("/{run_id}/recording.mcap", summary="The run's recording (MCAP, ROS1 encoding)")
+@router.get("/{run_id}/recording.mcap", summary="The run's recording (MCAP, as rosbag2 for ROS 2)")
 def recording(run_id: str, request: Request, caller: Caller = Depends(current_user)):
     record = visible_run(request, caller, run_id)
     path = Path(record.run_dir) / RECORDING_FILE
