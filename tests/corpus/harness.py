@@ -25,6 +25,7 @@ from functools import cached_property
 from pathlib import Path
 
 from mcap.reader import make_reader
+from mcap_ros2._vendor.rosidl_adapter.parser import InvalidResourceName
 from mcap_ros2.decoder import DecoderFactory
 
 from sandbox.msgs import get_message_class
@@ -85,7 +86,13 @@ class Outcome:
             for schema, channel, message in make_reader(f).iter_messages():
                 decode = decoders.get(channel.id)
                 if decode is None:
-                    decode = ros2.decoder_for(channel.message_encoding, schema)
+                    try:
+                        decode = ros2.decoder_for(channel.message_encoding, schema)
+                    except InvalidResourceName:
+                        # mcap-ros2-support refuses an action's own types (a name such as
+                        # Fibonacci_FeedbackMessage is not a .msg name), in rosbag2's
+                        # recordings too: those few are decoded by our classes.
+                        decode = None
                     if decode is None:
                         decode = get_message_class(schema.name).deserialize
                     decoders[channel.id] = decode

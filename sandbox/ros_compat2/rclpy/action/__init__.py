@@ -1,0 +1,15 @@
+"""`rclpy.action` for student code: ActionServer and ActionClient between the nodes of a run,
+wired as rcl_action wires them (see server.py and client.py), with GoalResponse and
+CancelResponse for the server's callbacks."""
+
+from .client import ActionClient, ClientGoalHandle
+from .server import ActionServer, CancelResponse, GoalResponse, ServerGoalHandle
+
+__all__ = [
+    "ActionClient",
+    "ActionServer",
+    "CancelResponse",
+    "ClientGoalHandle",
+    "GoalResponse",
+    "ServerGoalHandle",
+]
