@@ -37,7 +37,6 @@ LANE_FOLLOWING = (2.6, 2.95, 0.0)  # [m, m, rad] 0.45 m left of the corridor's s
 
 # Pieces of issue 13 not on main yet (removed as they land).
 AWAITING: tuple[str, ...] = ()
-ROS2LIBS = "rclpy.action, tf2_ros and nav2_simple_commander for ROS 2 nodes (ros2libs)"
 STAMPED_ZERO = "the run's final zero TwistStamped stamped with the node's frame_id"
 CHECK_REVIEW = "the case's script or check reviewed (rclpy runs it as written; see the report)"
 
@@ -159,7 +158,6 @@ CASES = (
         4.0,
         checks.check_fibonacci_action,
         nodes=(Node("fibonacci_action_server.py"), Node("fibonacci_action_client.py")),
-        needs=(ROS2LIBS,),
     ),
     ros2_case(
         "sync_call_timer",
@@ -186,7 +184,6 @@ CASES = (
         checks.check_tf2_odom_distance,
         nodes=(Node("tf2_odom_distance.py"),),
         spawn="start",
-        needs=(ROS2LIBS,),
     ),
     ros2_case(
         "tf2_map_turn",
@@ -196,7 +193,6 @@ CASES = (
         checks.check_tf2_map_turn,
         nodes=(Node("tf2_map_turn.py"),),
         spawn="start",
-        needs=(ROS2LIBS,),
     ),
     ros2_case(
         "go_to_goal",
@@ -302,7 +298,6 @@ CASES = (
         nodes=(Node("nav2_goto_pose.py"),),
         spawn="start",
         builtin_nodes=("map_server", "localization", "nav2"),
-        needs=(ROS2LIBS,),
     ),
     ros2_case(
         "launch_file",
