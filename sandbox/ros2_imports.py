@@ -83,14 +83,42 @@ MISSING_MODULES: dict[str, str] = {
     ),
     "gazebo_msgs": "there is no Gazebo; the robot's pose is in nav_msgs/msg/Odometry on odom",
     "ros_gz_interfaces": "there is no Gazebo; the robot's pose is in nav_msgs/msg/Odometry on odom",
-    "tf2_geometry_msgs": (
-        "transform points yourself: tf2_ros.Buffer.lookup_transform gives the transform, "
-        "tf_transformations.quaternion_matrix its rotation"
-    ),
     "tf2_sensor_msgs": (
-        "transform points yourself: tf2_ros.Buffer.lookup_transform gives the transform, "
-        "tf_transformations.quaternion_matrix its rotation"
+        "read the cloud with sensor_msgs_py.point_cloud2.read_points_numpy and move the points "
+        "with the transform tf2_ros's Buffer.lookup_transform gives (its rotation as a matrix: "
+        "tf_transformations.quaternion_matrix)"
     ),
+    "tf2_kdl": "use numpy for kinematics and tf_transformations for rotations",
+    "tf2_tools": (
+        f"{_CLI_TOOL}; a tf2_ros Buffer's all_frames_as_yaml() lists the frames it knows"
+    ),
+    "transforms3d": (
+        "it is not installed; tf_transformations has the functions courses use it for "
+        "(euler_from_quaternion, quaternion_from_euler, quaternion_matrix, euler_matrix)"
+    ),
+    "nav2_common": (
+        "its launch helpers are for Nav2's launch files; a run's built-in navigation needs no "
+        "parameter files"
+    ),
+    "robot_localization": (
+        "there is no EKF package; the run's localization node publishes the robot's pose"
+    ),
+    "slam_toolbox": (
+        "there is no SLAM; the map comes from the run's map_server on the map topic "
+        "(nav_msgs/msg/OccupancyGrid)"
+    ),
+    "rosbag2_py": (
+        "nodes cannot read or write bag files; every run is recorded, and its recording "
+        "downloads as MCAP from the run's page (ros2 bag play reads it)"
+    ),
+    "interactive_markers": "draw with visualization_msgs/msg/Marker and MarkerArray instead",
+    "python_qt_binding": (
+        "a node has no display; plot with matplotlib and save the figure (plt.savefig), which "
+        "comes back with the run's files"
+    ),
+    "py_trees": "write the behaviour as a state machine stepped by a timer callback",
+    "py_trees_ros": "write the behaviour as a state machine stepped by a timer callback",
+    "smach": "write the state machine as a loop over a state variable",
     "laser_geometry": (
         "project a sensor_msgs/msg/LaserScan yourself: beam i points at angle msg.angle_min + "
         "i * msg.angle_increment, so x = r * cos(angle), y = r * sin(angle)"
@@ -115,6 +143,17 @@ MISSING_RCLPY: dict[str, str] = {
     "rclpy.type_description_service": "type descriptions are not served in RoboDojo",
     "rclpy.service_introspection": "service introspection is not available in RoboDojo",
     "rclpy.impl": "rclpy's C bindings are not part of RoboDojo's rclpy",
+}
+
+# Library packages RoboDojo provides for ROS 2 nodes -> the modules they have (a missing
+# submodule, such as nav2_simple_commander.costmap_2d, names them).
+LIBRARY_MODULES: dict[str, str] = {
+    "nav2_simple_commander": "nav2_simple_commander.robot_navigator (BasicNavigator, TaskResult)",
+    "sensor_msgs_py": "sensor_msgs_py.point_cloud2",
+    "tf2_ros": (
+        "tf2_ros.buffer, tf2_ros.transform_listener, tf2_ros.transform_broadcaster, "
+        "tf2_ros.static_transform_broadcaster and tf2_ros.buffer_interface"
+    ),
 }
 
 _GENERIC_PACKAGE = (
@@ -150,6 +189,8 @@ def sentence_for(fullname: str) -> str | None:
             return f"{fullname} is not available in RoboDojo: {reason}"
     if top in MISSING_MODULES:
         return f"{top} is not available in RoboDojo: {MISSING_MODULES[top]}"
+    if top in LIBRARY_MODULES and rest:
+        return f"{fullname} is not available in RoboDojo: it has {LIBRARY_MODULES[top]}"
     ours = interface_packages()
     if top in ours and rest:
         kind, _, name = rest.partition(".")
@@ -157,7 +198,8 @@ def sentence_for(fullname: str) -> str | None:
             return f"{fullname} is not a module: write `from {top}.{kind} import {name}`"
         modules = " and ".join(f"{top}.{kind}" for kind in ours[top])
         return f"{fullname} is not available in RoboDojo: {top} has {modules} only"
-    if top.endswith(("_msgs", "_srvs", "_interfaces")) and top not in ours:
+    provided = os.path.isdir(os.path.join(ROS_COMPAT2_DIR, top))  # tf2_geometry_msgs is code
+    if top.endswith(("_msgs", "_srvs", "_interfaces")) and top not in ours and not provided:
         packages = ", ".join(ours)
         return f"{top} is not available in RoboDojo: {_GENERIC_PACKAGE.format(packages=packages)}"
     return None
