@@ -4,6 +4,10 @@ after a node reach its command line unchanged."""
 
 from __future__ import annotations
 
+import csv
+import json
+import subprocess
+import sys
 from pathlib import Path
 from textwrap import dedent
 
@@ -121,3 +125,49 @@ def test_ros_args_after_a_node_reach_its_command_line(tmp_path) -> None:
         [("node", str(node)), ("args", "--ros-args -p greeting:=hey -r chatter:=Control")]
     )
     assert spec.args == ("--ros-args", "-p", "greeting:=hey", "-r", "chatter:=Control")
+
+
+def robodojo(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "server.cli", *args],
+        capture_output=True,
+        text=True,
+        timeout=180,
+        check=False,
+    )
+
+
+def messages(out: Path, topic: str) -> list[str]:
+    exported = robodojo("export", str(out))
+    assert exported.returncode == 0, exported.stderr
+    with open(out / "csv" / f"{topic}.csv", newline="") as stream:
+        rows = list(csv.DictReader(stream))
+    (column,) = [name for name in rows[0] if name.endswith("data")] if rows else ["data"]
+    return [row[column] for row in rows]
+
+
+def test_two_rclpy_nodes_run_from_a_launch_file(tmp_path) -> None:
+    launch = write_package(tmp_path / "chat")
+    out = tmp_path / "out"
+    done = robodojo(*BASE, "--out", str(out), "--launch", str(launch), "greeting:=hey")
+    assert done.returncode == 0, done.stderr
+    summary = json.loads(done.stdout.strip().splitlines()[-1])
+    assert summary["state"] == "finished", summary
+    # speaker: the launch's name (-r __node:=speaker), the YAML's words.first for /speaker, the
+    # argument through the dict; its chatter remapped to conversation, which the listener
+    # (its heard remapped too) echoes.
+    said = messages(out, "conversation")
+    assert said and set(said) == {"hey robots from speaker"}, said[:3]
+    echoed = messages(out, "echo")
+    assert echoed and set(echoed) == {"hey robots from speaker"}, echoed[:3]
+
+
+def test_ros_args_set_a_parameter_and_a_remap_of_a_node(tmp_path) -> None:
+    node = tmp_path / "talker.py"
+    node.write_text(TALKER + '\n\nif __name__ == "__main__":\n    main()\n')
+    out = tmp_path / "out"
+    ros_args = "--ros-args -p greeting:=yo -p words.first:=wheels -r chatter:=conversation"
+    done = robodojo(*BASE, "--out", str(out), "--node", str(node), "--args", ros_args)
+    assert done.returncode == 0, done.stderr
+    said = messages(out, "conversation")
+    assert said and set(said) == {"yo wheels from talker"}, said[:3]
