@@ -255,8 +255,13 @@ def test_a_ros2_launch_file_is_read_in_the_sandbox_into_the_runs_nodes(lab):
     started = launch(student, "launch/chat.launch.py", args={"rate": "10.0"})
     assert started.status_code == 201, started.text
     run = wait_for_end(student, started.json()["id"])
+    assert run["state"] == "finished", run["reason"]
     assert [node["name"] for node in run["code"]] == ["talker"]
     assert run["code"][0]["code"] == ROS2_NODE
+    # The launch's name (over the code's "chatter") in its namespace; the argument's rate over
+    # the YAML's (the dict comes after the file).
+    logs = student.get(f"/api/runs/{run['id']}/logs").json()["nodes"]["talker"]
+    assert any("[robot1.talker]: rate 10.0" in line for line in logs), logs
 
 
 ROS2_MISTAKES = {
