@@ -103,3 +103,35 @@ executor.shutdown()
     yields, exited, _ = run(code, tmp_path)
     assert exited.outcome is Outcome.FINISHED, exited.error
     assert [m.data for m in published(yields, exited, "sum")] == [10, 11, 12]
+
+
+def test_joining_the_spin_thread_lets_its_callbacks_run(tmp_path: Path) -> None:
+    code = """
+import threading
+import rclpy
+from rclpy.executors import MultiThreadedExecutor
+from rclpy.node import Node
+from std_msgs.msg import Int32
+
+rclpy.init()
+node = Node('joiner')
+out = node.create_publisher(Int32, 'ticks', 10)
+count = [0]
+
+def tick():
+    count[0] += 1
+    out.publish(Int32(data=count[0]))
+    if count[0] == 3:
+        rclpy.shutdown()
+
+node.create_timer(0.5, tick)
+executor = MultiThreadedExecutor()
+executor.add_node(node)
+thread = threading.Thread(target=executor.spin)
+thread.start()
+thread.join()   # waits here while the timer runs, until the callback shuts rclpy down
+"""
+    yields, exited, _ = run(code, tmp_path)
+    assert exited.outcome is Outcome.FINISHED, exited.error
+    assert [m.data for m in published(yields, exited, "ticks")] == [1, 2, 3]
+    assert [y.wake_at_s for y in yields][:3] == [0.5, 1.0, 1.5]

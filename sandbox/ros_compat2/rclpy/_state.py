@@ -41,6 +41,7 @@ class ProcessState:
         self.global_executor: Executor | None = None
         self.nodes: list[Node] = []
         self.background: list[Executor] = []  # spun from a thread of the student's
+        self.spin_threads: set[threading.Thread] = set()
         # (group, executor) of each callback running now, innermost last
         self.executing: list[tuple[CallbackGroup | None, Executor | None]] = []
         self.logger_levels: dict[str, int] = {}
@@ -178,6 +179,42 @@ class ProcessState:
         if key not in self.warned:
             self.warned.add(key)
             self.runtime.warn(text)
+
+
+_original_join = threading.Thread.join
+
+
+def _join(thread: threading.Thread, timeout: float | None = None) -> None:
+    """Thread.join on a spin thread, from the node's thread: that thread only waits for the
+    context to shut down while its callbacks run on the node's thread, so joining it means
+    waiting here, letting the run's time pass and those callbacks run (in ROS 2 the spin
+    thread would run them while the main thread waits in join)."""
+    node_runtime = sandbox_runtime._current
+    current = getattr(node_runtime, "rclpy_state", None)
+    if (
+        current is None
+        or thread not in current.spin_threads
+        or not current.on_node_thread()
+        or node_runtime.shutdown is not None
+    ):
+        _original_join(thread, timeout)
+        return
+    deadline_ns = None if timeout is None else now_ns() + int(timeout * 1e9)
+    try:
+        while thread.is_alive() and current.background:
+            if deadline_ns is not None and now_ns() >= deadline_ns:
+                return
+            wait(deadline_ns, None)
+    except RunEndedInterrupt:
+        pass
+    _original_join(thread, 1.0)  # it ends within its next look at the context
+
+
+def note_spin_thread(thread: threading.Thread) -> None:
+    """A thread of the student's spins an executor (install the join above once)."""
+    state().spin_threads.add(thread)
+    if threading.Thread.join is not _join:
+        threading.Thread.join = _join  # type: ignore[method-assign]
 
 
 def _policy_name(kind: int) -> str:

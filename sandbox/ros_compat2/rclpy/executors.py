@@ -115,7 +115,10 @@ class Executor:
             _state.state().refresh_wake_topics()
 
     def wake(self) -> None:
-        """Nothing to do: the executor looks afresh at every wait."""
+        """The executor looks afresh at every wait; a spin "in another thread" ends once its
+        context has shut down."""
+        if not self._context.ok():
+            self._release_background()
 
     def get_nodes(self) -> list[Node]:
         return list(self._nodes)
@@ -267,7 +270,8 @@ class Executor:
     def _execute(self, work: _Work) -> None:
         call, entity, _ = work
         if isinstance(entity, Task):
-            entity()
+            with _state.state().executing_callback(None, self):
+                entity()
             if entity.done() and entity.exception() is not None:
                 raise entity.exception()  # type: ignore[misc]
             return
@@ -279,7 +283,8 @@ class Executor:
             if inspect.iscoroutine(result):  # an `async def` callback: a task of its own
                 task: Task[Any] = Task(result, executor=self)
                 self._tasks.append(task)
-                task()
+                with _state.state().executing_callback(group, self):
+                    task()
                 if task.done() and task.exception() is not None:
                     raise task.exception()  # type: ignore[misc]
         finally:
@@ -308,6 +313,7 @@ class Executor:
         current = _state.state()
         release = threading.Event()
         self._background_release = release
+        _state.note_spin_thread(threading.current_thread())
         current.background.append(self)
         current.refresh_wake_topics()
         try:
