@@ -117,6 +117,15 @@ def test_twist_and_twist_stamped_both_drive_the_robot(tmp_path):
     run.recorder.close()
 
 
+def test_other_command_topics_take_their_ros2_type(tmp_path):
+    run = prepared(tmp_path)
+    leds = get_message_class("std_msgs/msg/Int32MultiArray")(data=[255, 0, 64])
+    run._from_node(run.slots["driver"], [Envelope("Leds", leds._type, leds.serialize())])
+    assert run.sim.read("Leds")._type == "std_msgs/Int32MultiArray"
+    assert list(run.sim.read("Leds").data) == [255, 0, 64]
+    run.recorder.close()
+
+
 def test_another_type_on_the_velocity_topic_is_said_once_and_ignored(tmp_path):
     run = prepared(tmp_path)
     slot = run.slots["driver"]
