@@ -239,3 +239,10 @@ def test_the_wire_is_rcl_actions(launcher, tmp_path: Path) -> None:
     services = ("send_goal", "get_result", "cancel_goal")
     for name in services:
         assert f"__srv__/fibonacci/_action/{name}" in outcome.graph, sorted(outcome.graph)
+    # One result request, sent when the goal was accepted and answered when it ended (as
+    # rcl_action holds it), not asked again.
+    requests = outcome.messages("__srv__/fibonacci/_action/get_result")
+    replies = outcome.messages("__srv__reply/fibonacci_client")
+    assert len(requests) == 1, requests
+    feedbacks = outcome.messages("fibonacci/_action/feedback")
+    assert replies[-1][0] >= feedbacks[-1][0] > requests[0][0]

@@ -11,9 +11,9 @@ spin_once loop, or an executor), as in rclpy. send_goal(), get_result() and canc
 for their answer by spinning the node here; rclpy's wait on a threading.Event that only another
 thread spinning the node can release, which a one-thread node does not have.
 
-A get_result answer for a goal that has not ended yet (this package's ActionServer gives one,
-see server.py) is not a result: the client asks again when the status topic shows the goal
-ended, so the Future completes with the real result either way.
+A get_result answer for a goal that has not ended yet (a server that answers at once rather
+than when the goal ends, as rcl_action's do) is not taken for a result: the client asks again
+when the status topic shows the goal ended.
 """
 
 from __future__ import annotations

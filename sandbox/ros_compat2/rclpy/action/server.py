@@ -12,11 +12,9 @@ callback returns the action's Result after calling goal_handle.succeed(), abort(
 publish feedback; while it runs, the node's other callbacks wait, as in a single-threaded
 executor. A cancel request goes to cancel_callback (default: reject) for each goal it names.
 Finished goals are kept result_timeout seconds (rclpy's default 10 s) for late result requests.
-
-One difference, on the wire only: a get_result request for a goal still running is answered at
-once with the goal's current status (rcl_action holds it until the goal ends); the
-ActionClient of this package then asks again when the status topic reports the goal finished,
-so get_result_async() completes at the same moment as in ROS 2.
+A get_result request for a goal still running is answered when the goal ends, as rcl_action
+holds it: the service callback is a coroutine awaiting the goal's result (rclpy runs an async
+service callback as a task and sends what it returns).
 """
 
 from __future__ import annotations
@@ -26,6 +24,7 @@ import traceback
 from enum import Enum
 from typing import Any
 
+from rclpy.task import Future
 from sandbox.action_goals import ActionGoals, CancelCode, Goal, GoalEvent, GoalStatus
 from sandbox.msgs import get_message_class
 
@@ -179,6 +178,7 @@ class ActionServer:
         self._goals = ActionGoals()
         self._handles: dict[bytes, ServerGoalHandle] = {}
         self._results: dict[bytes, Any] = {}  # uuid -> GetResultService.Response, once ended
+        self._waiting: dict[bytes, Future] = {}  # uuid -> the result a get_result awaits
         self._logger = wire.child_logger(node, "action_server")
         names = wire.names(action_name)
         impl = action_type.Impl
@@ -274,22 +274,21 @@ class ActionServer:
         wire.run_callback(self._handle_accepted_callback, handle)
         return response
 
-    def _on_get_result(self, request: Any, response: Any) -> Any:
+    async def _on_get_result(self, request: Any, response: Any) -> Any:
         self._expire()
         key = wire.uuid_bytes(request.goal_id)
         if key in self._results:
             return self._results[key]
-        handle = self._handles.get(key)
-        if handle is None:
+        if key not in self._handles:
             self._logger.warning(
                 f"Sending result response for unknown or expired goal ID: {list(bytearray(key))}"
             )
             response.status = int(GoalStatus.UNKNOWN)
             return response
-        # Still running, or ended with its execute callback not yet returned: the client asks
-        # again when the status topic shows the goal ended (published again with the result).
-        response.status = handle.status if handle.is_active else int(GoalStatus.EXECUTING)
-        return response
+        waiting = self._waiting.get(key)
+        if waiting is None:
+            waiting = self._waiting[key] = Future()
+        return await waiting  # the goal's GetResult response, once its execute callback ends
 
     def _on_cancel(self, request: Any, response: Any) -> Any:
         self._expire()
@@ -352,7 +351,9 @@ class ActionServer:
         response.result = result
         self._results[handle._goal.uuid] = response
         self._goals.goals[handle._goal.uuid].result = result
-        self._publish_status()  # tells a waiting client that the result is there
+        waiting = self._waiting.pop(handle._goal.uuid, None)
+        if waiting is not None:
+            waiting.set_result(response)
 
     def destroy(self) -> None:
         """Stop serving the action."""
