@@ -111,14 +111,22 @@ def bag_metadata(
     }
 
 
+class _PlainDumper(yaml.SafeDumper):
+    """YAML without anchors and aliases: the document shares dicts (start time, duration),
+    which PyYAML would write as `&id001`/`*id001`; rosbag2 writes every value out."""
+
+    def ignore_aliases(self, data: object) -> bool:
+        return True
+
+
 def serialized(metadata: dict) -> str:
     """The document as the "rosbag2" MCAP metadata record carries it (YAML, no outer key)."""
-    return yaml.safe_dump(metadata, sort_keys=False)
+    return yaml.dump(metadata, Dumper=_PlainDumper, sort_keys=False)
 
 
 def write_metadata_yaml(out_dir: Path, metadata: dict) -> Path:
     """`metadata.yaml` beside the MCAP file, as rosbag2's MetadataIo writes it."""
     path = Path(out_dir) / METADATA_FILE
     document = {"rosbag2_bagfile_information": metadata}
-    path.write_text(yaml.safe_dump(document, sort_keys=False), encoding="utf-8")
+    path.write_text(yaml.dump(document, Dumper=_PlainDumper, sort_keys=False), encoding="utf-8")
     return path
