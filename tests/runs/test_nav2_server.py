@@ -301,3 +301,51 @@ def test_a_new_goal_preempts_the_running_one_which_ends_aborted(tmp_path, launch
     assert "preempted" in " ".join(words)
     pose = run.sim.state.pose
     assert math.hypot(pose.x - 2.0, pose.y - 2.3) <= 0.25
+
+
+CANCEL_WAYPOINTS = """
+import rclpy
+from geometry_msgs.msg import PoseStamped
+from nav2_simple_commander.robot_navigator import BasicNavigator, TaskResult
+from rclpy.duration import Duration
+
+
+def pose(navigator, x, y):
+    p = PoseStamped()
+    p.header.frame_id = "map"
+    p.header.stamp = navigator.get_clock().now().to_msg()
+    p.pose.position.x, p.pose.position.y = x, y
+    p.pose.orientation.w = 1.0
+    return p
+
+
+rclpy.init()
+navigator = BasicNavigator()
+navigator.waitUntilNav2Active()
+navigator.followWaypoints([pose(navigator, 2.0, 2.2), pose(navigator, 3.0, 2.2)])
+start = navigator.get_clock().now()
+while not navigator.isTaskComplete():
+    if navigator.get_clock().now() - start > Duration(seconds=2.0):
+        navigator.cancelTask()
+print("result", navigator.getResult() == TaskResult.CANCELED)
+rclpy.shutdown()
+"""
+
+
+def test_canceling_follow_waypoints_cancels_its_navigation_and_stops(tmp_path, launcher):
+    spec = RunSpec(
+        "turtlebot",
+        "office",
+        (NodeSpec("mission", CANCEL_WAYPOINTS, "mission.py"),),
+        clock=Clock.LOCKSTEP,
+        duration_s=10.0,
+        spawn="start",
+        builtin_nodes=NAV2,
+    )
+    run = Run(spec, launcher, tmp_path / "run")
+    result = run.execute()
+    assert result.state is RunState.FINISHED, result.reason
+    assert line(list(run.slots["mission"].logs), "result") == ["result", "True"]
+    log = "".join(path.read_text() for path in (tmp_path / "run" / "logs").glob("nav2*"))
+    assert "navigate_to_pose: canceled by a client" in log
+    assert "heading to (3.00, 2.20)" not in log  # the second waypoint never started
