@@ -106,6 +106,7 @@ rclpy.spin(Server())
 
 CLIENT = """
 import rclpy
+import rclpy.action
 from rclpy.action import ActionClient
 from rclpy.node import Node
 from example_interfaces.action import Fibonacci
@@ -138,6 +139,7 @@ rclpy.init()
 node = Client()
 assert node.client.wait_for_server(timeout_sec=5.0)
 node.get_logger().info(f"server ready={node.client.server_is_ready()}")
+node.get_logger().info(f"actions {rclpy.action.get_action_names_and_types(node)}")
 goal = Fibonacci.Goal(order=ORDER)
 future = node.client.send_goal_async(goal, feedback_callback=node.on_feedback)
 rclpy.spin_until_future_complete(node, future)
@@ -195,6 +197,7 @@ def test_the_tutorial_goal_gets_its_feedback_in_order_and_its_result(
     assert feedback_lines(client) == [str(sequence[:n]) for n in range(3, 8)]
     assert "result status=4 sequence=[0, 1, 1, 2, 3, 5, 8] handle status=4" in client
     assert "goal request order=6" in outcome.log("fibonacci_server")
+    assert "actions [('/fibonacci', ['example_interfaces/action/Fibonacci'])]" in client
 
 
 def test_a_cancel_the_server_accepts_ends_the_goal_canceled(launcher, tmp_path: Path) -> None:

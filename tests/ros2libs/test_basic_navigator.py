@@ -98,6 +98,10 @@ while not navigator.isTaskComplete():
 navigator.get_logger().info(f"second {navigator.getResult()}")
 navigator.lifecycleShutdown()
 try:
+    navigator.goThroughPoses([pose(1.0, 0.0)])
+except RuntimeError as error:
+    navigator.get_logger().info(f"through poses: {error}")
+try:
     navigator.clearAllCostmaps()
 except AttributeError as error:
     navigator.get_logger().info(f"costmaps: {error}")
@@ -121,6 +125,7 @@ def test_a_goal_to_success_and_one_canceled(launcher, tmp_path: Path) -> None:
     assert remaining[0] >= 0.9 and remaining[-1] <= 0.2
     assert "second TaskResult.CANCELED" in commander
     assert "costmaps: BasicNavigator.clearAllCostmaps() is not available" in commander
+    assert "through poses: BasicNavigator.goThroughPoses() needs the " in commander
 
 
 WAYPOINTS = """

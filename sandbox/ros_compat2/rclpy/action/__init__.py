@@ -3,6 +3,11 @@ wired as rcl_action wires them (see server.py and client.py), with GoalResponse 
 CancelResponse for the server's callbacks."""
 
 from .client import ActionClient, ClientGoalHandle
+from .graph import (
+    get_action_client_names_and_types_by_node,
+    get_action_names_and_types,
+    get_action_server_names_and_types_by_node,
+)
 from .server import ActionServer, CancelResponse, GoalResponse, ServerGoalHandle
 
 __all__ = [
@@ -12,4 +17,7 @@ __all__ = [
     "ClientGoalHandle",
     "GoalResponse",
     "ServerGoalHandle",
+    "get_action_client_names_and_types_by_node",
+    "get_action_names_and_types",
+    "get_action_server_names_and_types_by_node",
 ]
