@@ -913,6 +913,22 @@ uint16 error_code
 string error_msg""",
         "uint32 current_waypoint",
     ),
+    "nav2_msgs/action/NavigateThroughPoses": (
+        """\
+geometry_msgs/PoseStamped[] poses
+string behavior_tree""",
+        """\
+uint16 NONE=0
+uint16 error_code
+string error_msg""",
+        """\
+geometry_msgs/PoseStamped current_pose
+builtin_interfaces/Duration navigation_time
+builtin_interfaces/Duration estimated_time_remaining
+int16 number_of_recoveries
+float32 distance_remaining
+int16 number_of_poses_remaining""",
+    ),
     "nav2_msgs/action/NavigateToPose": (
         """\
 geometry_msgs/PoseStamped pose

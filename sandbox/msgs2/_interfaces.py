@@ -128,6 +128,13 @@ ACTIONS: dict[str, tuple[str, str, str]] = {
         "builtin_interfaces/Duration estimated_time_remaining\nint16 number_of_recoveries\n"
         "float32 distance_remaining",
     ),
+    "nav2_msgs/action/NavigateThroughPoses": (
+        "geometry_msgs/PoseStamped[] poses\nstring behavior_tree",
+        "uint16 NONE=0\nuint16 error_code\nstring error_msg",
+        "geometry_msgs/PoseStamped current_pose\nbuiltin_interfaces/Duration navigation_time\n"
+        "builtin_interfaces/Duration estimated_time_remaining\nint16 number_of_recoveries\n"
+        "float32 distance_remaining\nint16 number_of_poses_remaining",
+    ),
     "nav2_msgs/action/FollowWaypoints": (
         "uint32 number_of_loops\nuint32 goal_index 0\ngeometry_msgs/PoseStamped[] poses",
         "uint16 NONE=0\nuint16 UNKNOWN=600\nuint16 TASK_EXECUTOR_FAILED=601\n"

@@ -152,6 +152,8 @@ class Navigation:
     pending_since_ns: int = 0
     missed_periods: int = 0
     service_missing_since_ns: int | None = None
+    wire: Any = None  # the action it serves (navigate_to_pose or navigate_through_poses)
+    via: list[tuple[float, float]] = field(default_factory=list)  # poses still to pass
 
     def reached(self, pose: Pose) -> bool:
         return self.goal_checker.reached(pose, self.goal)

@@ -1,14 +1,17 @@
-"""The built-in navigation server of ROS 2 runs: Nav2's `navigate_to_pose` and
-`follow_waypoints` actions, served over the rcl_action wire (nav2_wire.py) the way a Nav2 stack
-serves them, so rclpy's ActionClient and nav2_simple_commander's BasicNavigator work against it.
+"""The built-in navigation server of ROS 2 runs: Nav2's `navigate_to_pose`,
+`navigate_through_poses`, `follow_waypoints` and `compute_path_to_pose` actions, served over the
+rcl_action wire (nav2_wire.py) the way a Nav2 stack serves them, so rclpy's ActionClient and
+nav2_simple_commander's BasicNavigator work against it.
 
 One goal at a time, as bt_navigator runs one: a new NavigateToPose goal preempts the one
-running, which ends ABORTED (Nav2's SimpleActionServer aborts the current goal when it accepts
-a pending one). A goal is planned at once (nav2_navigation.plan_path: a goal that cannot be
+running, which ends ABORTED (Nav2's SimpleActionServer aborts the current goal when it accepts a
+pending one); a goal of the other navigator meanwhile is refused (bt_navigator's
+NavigatorMuxer). A goal is planned at once (nav2_navigation.plan_path: a goal that cannot be
 reached ends ABORTED with a sentence), then driven each control period until the goal checker
 says it is reached (SUCCEEDED), the progress checker says the robot is stuck (ABORTED), or a
 client cancels it (CANCELED). Recoveries (spin, back up, wait) are not run: number_of_recoveries
-stays 0 and a failure ends the goal.
+stays 0 and a failure ends the goal. `navigate_through_poses` plans leg by leg into one path;
+its number_of_poses_remaining counts the poses not yet passed within 0.5 m (RemovePassedGoals).
 
 `follow_waypoints` is Nav2's waypoint follower: a NavigateToPose goal per waypoint (visible on
 navigate_to_pose's status topic, as the follower is its client), a 200 ms pause at each
@@ -27,6 +30,8 @@ from __future__ import annotations
 
 import math
 from typing import TYPE_CHECKING, Any
+
+import numpy as np
 
 from sandbox.action_goals import Goal, GoalEvent, GoalStatus, GoalTransitionError
 from sandbox.msgs import get_message_class
@@ -55,6 +60,8 @@ WAYPOINT_PAUSE_S = 0.2  # [s] WaitAtWaypoint's waypoint_pause_duration default (
 TURNING_RADIUS_M = 0.4  # [m] SMAC Hybrid-A*'s minimum_turning_radius default
 CONTROLLER_SERVICE_TYPE = "robodojo_msgs/srv/ComputeVelocityCommands"
 NAVIGATE = "navigate_to_pose"
+THROUGH = "navigate_through_poses"
+PASSED_RADIUS_M = 0.5  # [m] a via pose counts as passed this close (RemovePassedGoals' radius)
 FOLLOW = "follow_waypoints"
 COMPUTE_PATH = "compute_path_to_pose"
 GLOBAL_FRAMES = ("map", "")  # goal frames used as they are (Nav2 transforms others via tf)
@@ -134,7 +141,7 @@ class NavigationServer(BuiltinNode):
         """The actions' request topics: clients' wait_for_server looks for their subscriber."""
         return tuple(
             (request_topic(f"{action}/_action/{service}"), SERVICE_CALL)
-            for action in (NAVIGATE, FOLLOW, COMPUTE_PATH)
+            for action in (NAVIGATE, THROUGH, FOLLOW, COMPUTE_PATH)
             for service in ("send_goal", "get_result", "cancel_goal")
         )
 
@@ -163,6 +170,9 @@ class NavigationServer(BuiltinNode):
             )
         self.turning_radius_m = float(params.get("minimum_turning_radius", TURNING_RADIUS_M))
         self.navigate = ActionWire(NAVIGATE, get_action_class("nav2_msgs/action/NavigateToPose"))
+        self.through = ActionWire(
+            THROUGH, get_action_class("nav2_msgs/action/NavigateThroughPoses")
+        )
         self.follow = ActionWire(FOLLOW, get_action_class("nav2_msgs/action/FollowWaypoints"))
         self.compute = ActionWire(
             COMPUTE_PATH, get_action_class("nav2_msgs/action/ComputePathToPose")
@@ -178,7 +188,7 @@ class NavigationServer(BuiltinNode):
         self.current: Navigation | None = None
         self.mission: Mission | None = None
         self.subscribes = ("pose",) + ((self.client.reply_topic,) if self.client else ())
-        for wire in (self.navigate, self.follow, self.compute):
+        for wire in (self.navigate, self.through, self.follow, self.compute):
             for topic, type_name in wire.published:
                 run.bus.declare_topic(topic, type_name, self.name)
             run.bus.topics[wire.status_topic].latched_by.add(self.name)  # transient local
@@ -195,7 +205,7 @@ class NavigationServer(BuiltinNode):
             return []
         if self.client is not None and topic == self.client.reply_topic:
             return self._controller_answer(run, message)
-        for wire in (self.navigate, self.follow, self.compute):
+        for wire in (self.navigate, self.through, self.follow, self.compute):
             if topic in wire.request_topics:
                 request = wire.request(topic, message)
                 if topic == wire.send_goal:
@@ -207,6 +217,11 @@ class NavigationServer(BuiltinNode):
 
     def _send_goal(self, run: Run, wire: ActionWire, call: Any, request: Any) -> list:
         uuid = bytes(request.goal_id.uuid)
+        busy = self.current is not None and self.current.wire is not wire
+        if wire in (self.navigate, self.through) and busy:
+            # bt_navigator's NavigatorMuxer: one navigator at a time, the other's goals refused
+            self.log(run, "WARN", f"{wire.name}: refused while {self.current.wire.name} runs")
+            return [reply(call, wire.goal_response(False, run.time_ns))]
         try:
             goal = wire.goals.accept(uuid, run.time_ns, request.goal)
         except GoalTransitionError:
@@ -214,8 +229,8 @@ class NavigationServer(BuiltinNode):
         out = [reply(call, wire.goal_response(True, run.time_ns))]
         goal.update(GoalEvent.EXECUTE)
         out.append(wire.status())
-        if wire is self.navigate:
-            out += self._start_navigation(run, goal)
+        if wire in (self.navigate, self.through):
+            out += self._start_navigation(run, goal, wire)
         elif wire is self.follow:
             out += self._start_mission(run, goal)
         else:
@@ -273,76 +288,96 @@ class NavigationServer(BuiltinNode):
                 out += self._end(
                     run, self.follow, goal, GoalEvent.CANCELED, self._mission_result(mission)
                 )
-            elif wire is self.navigate:
-                out += self._cancel_navigation(run, goal.uuid)
+            elif wire in (self.navigate, self.through):
+                out += self._cancel_navigation(run, goal.uuid, wire)
         return out
 
-    def _cancel_navigation(self, run: Run, uuid: bytes | None) -> list:
-        goal = self.navigate.goals.goals.get(uuid) if uuid else None
+    def _cancel_navigation(
+        self, run: Run, uuid: bytes | None, wire: ActionWire | None = None
+    ) -> list:
+        wire = wire or self.navigate
+        goal = wire.goals.goals.get(uuid) if uuid else None
         if goal is None or goal.status.terminal:
             return []
         if goal.status is not GoalStatus.CANCELING:
             goal.update(GoalEvent.CANCEL_GOAL)
         if self.current is not None and self.current.uuid == uuid:
             return self._finish_navigation(run, GoalEvent.CANCELED, "", "canceled by a client")
-        result = self.navigate.action.Result()
-        return self._end(run, self.navigate, goal, GoalEvent.CANCELED, result)
+        return self._end(run, wire, goal, GoalEvent.CANCELED, wire.action.Result())
 
     # ------------------------------------------------------------------ navigation
-    def _start_navigation(self, run: Run, goal: Goal) -> list:
+    def _start_navigation(self, run: Run, goal: Goal, wire: ActionWire | None = None) -> list:
+        wire = wire or self.navigate
         out = []
         if self.current is not None:
             out += self._finish_navigation(
                 run, GoalEvent.ABORT, "PREEMPTED", "preempted: a newer goal arrived"
             )
         self.current = None
-        target = goal.request.pose
-        frame = target.header.frame_id.strip("/")
-        if goal.request.behavior_tree:
+        request = goal.request
+        targets = [request.pose] if wire is self.navigate else list(request.poses)
+        frames = {target.header.frame_id.strip("/") for target in targets}
+        if request.behavior_tree:
             return out + self._abort_now(
                 run, goal, "FAILED_TO_LOAD_BEHAVIOR_TREE",
                 "the lab's navigator runs Nav2's default behaviour tree only; "
-                "leave behavior_tree empty",
+                "leave behavior_tree empty", wire,
             )  # fmt: skip
-        if frame not in GLOBAL_FRAMES:
+        if not targets:
+            return out + self._abort_now(run, goal, "UNKNOWN", "no poses to go through", wire)
+        if not frames <= set(GLOBAL_FRAMES):
             return out + self._abort_now(
                 run, goal, "TF_ERROR",
-                f"the goal is in frame '{frame}'; the lab's navigator takes goals in 'map'",
+                f"a goal is in frame '{sorted(frames - set(GLOBAL_FRAMES))[0]}'; the lab's "
+                "navigator takes goals in 'map'", wire,
             )  # fmt: skip
         if self.pose is None:
-            return out + self._abort_now(run, goal, "TF_ERROR", "no pose from the localization yet")
-        pose = target.pose
-        end = (pose.position.x, pose.position.y, yaw_of(pose.orientation))
+            return out + self._abort_now(
+                run, goal, "TF_ERROR", "no pose from the localization yet", wire
+            )
+        ends = [(t.pose.position.x, t.pose.position.y, yaw_of(t.pose.orientation)) for t in targets]
+        legs, start = [], self.pose
         try:
-            points, yaws = self._plan(self.pose, end)
+            for end in ends:  # through poses: one plan per leg, joined
+                points, yaws = self._plan(start, end)
+                legs.append((points, yaws) if not legs else (points[1:], yaws[1:]))
+                start = end
         except NoPath as error:
-            self.log(run, "WARN", f"navigate_to_pose: {error}")
-            return out + self._abort_now(run, goal, error.code, str(error))
+            self.log(run, "WARN", f"{wire.name}: {error}")
+            return out + self._abort_now(run, goal, error.code, str(error), wire)
+        points = np.concatenate([leg[0] for leg in legs])
+        yaws = np.concatenate([leg[1] for leg in legs])
+        end = ends[-1]
         self.current = Navigation(
-            goal.uuid, end, points, run.time_ns, GoalChecker(self.xy_tol, self.yaw_tol)
+            goal.uuid, end, points, run.time_ns, GoalChecker(self.xy_tol, self.yaw_tol), wire=wire
         )
+        self.current.via = [e[:2] for e in ends[:-1]]
         self.follower.reset()
         path = self._path_message(points, yaws, run.time_ns)
         self.path_message = path
-        self.log(run, "INFO", f"navigate_to_pose: heading to ({end[0]:.2f}, {end[1]:.2f})")
+        self.log(run, "INFO", f"{wire.name}: heading to ({end[0]:.2f}, {end[1]:.2f})")
         return [*out, ("plan", path)]
 
-    def _abort_now(self, run: Run, goal: Goal, code: str, message: str) -> list:
-        result = _with_error(self.navigate.action.Result(), code, message)
-        out = self._end(run, self.navigate, goal, GoalEvent.ABORT, result, message)
+    def _abort_now(
+        self, run: Run, goal: Goal, code: str, message: str, wire: ActionWire | None = None
+    ) -> list:
+        wire = wire or self.navigate
+        result = _with_error(wire.action.Result(), code, message)
+        out = self._end(run, wire, goal, GoalEvent.ABORT, result, message)
         return out + self._mission_step(run, goal, GoalStatus.ABORTED, result)
 
     def _finish_navigation(self, run: Run, event: GoalEvent, code: str, message: str) -> list:
         nav, self.current = self.current, None
         if nav is None:
             return []
-        goal = self.navigate.goals.goals[nav.uuid]
-        result = _with_error(self.navigate.action.Result(), code, message if code else "")
+        wire = nav.wire
+        goal = wire.goals.goals[nav.uuid]
+        result = _with_error(wire.action.Result(), code, message if code else "")
         out = [(run.velocity_topic, _twist(0.0, 0.0))]
         if message and event is not GoalEvent.SUCCEED:
             self.log(run, "WARN" if event is GoalEvent.ABORT else "INFO",
-                     f"navigate_to_pose: {message}")  # fmt: skip
-        out += self._end(run, self.navigate, goal, event, result, message)
+                     f"{wire.name}: {message}")  # fmt: skip
+        out += self._end(run, wire, goal, event, result, message)
         return out + self._mission_step(run, goal, goal.status, result)
 
     def _end(self, run: Run, wire: ActionWire, goal: Goal, event: GoalEvent, result: Any,
@@ -376,14 +411,18 @@ class NavigationServer(BuiltinNode):
         else:
             out += self._call_controller(run, nav, pose)
         speed = run.sim.state.linear_m_s
-        feedback = self.navigate.action.Feedback(
+        feedback = nav.wire.action.Feedback(
             current_pose=_pose_stamped(*pose, run.time_ns),
             navigation_time=duration_msg((run.time_ns - nav.started_ns) / NS),
             estimated_time_remaining=duration_msg(nav.eta_s(pose, speed)),
             number_of_recoveries=0,
             distance_remaining=nav.distance_remaining(pose),
         )
-        out.append(self.navigate.feedback(nav.uuid, feedback))
+        if nav.wire is self.through:  # via poses drop out as the robot passes them
+            while nav.via and math.dist(nav.via[0], pose[:2]) <= PASSED_RADIUS_M:
+                nav.via.pop(0)
+            feedback.number_of_poses_remaining = len(nav.via) + 1
+        out.append(nav.wire.feedback(nav.uuid, feedback))
         return out
 
     def _call_controller(self, run: Run, nav: Navigation, pose: Pose) -> list:

@@ -349,3 +349,52 @@ def test_canceling_follow_waypoints_cancels_its_navigation_and_stops(tmp_path, l
     log = "".join(path.read_text() for path in (tmp_path / "run" / "logs").glob("nav2*"))
     assert "navigate_to_pose: canceled by a client" in log
     assert "heading to (3.00, 2.20)" not in log  # the second waypoint never started
+
+
+THROUGH = """
+import rclpy
+from geometry_msgs.msg import PoseStamped
+from nav2_simple_commander.robot_navigator import BasicNavigator, TaskResult
+
+
+def pose(navigator, x, y):
+    p = PoseStamped()
+    p.header.frame_id = "map"
+    p.pose.position.x, p.pose.position.y = x, y
+    p.pose.orientation.w = 1.0
+    return p
+
+
+rclpy.init()
+navigator = BasicNavigator()
+navigator.waitUntilNav2Active()
+navigator.goThroughPoses([pose(navigator, 2.0, 2.2), pose(navigator, 3.0, 2.2)])
+remaining = []
+while not navigator.isTaskComplete():
+    feedback = navigator.getFeedback()
+    if feedback and (not remaining or remaining[-1] != feedback.number_of_poses_remaining):
+        remaining.append(feedback.number_of_poses_remaining)
+print("result", navigator.getResult() == TaskResult.SUCCEEDED, "remaining", remaining)
+rclpy.shutdown()
+"""
+
+
+def test_navigate_through_poses_passes_each_and_counts_them_down(tmp_path, launcher):
+    spec = RunSpec(
+        "turtlebot",
+        "office",
+        (NodeSpec("through", THROUGH, "through.py"),),
+        clock=Clock.LOCKSTEP,
+        duration_s=20.0,
+        spawn="start",
+        builtin_nodes=NAV2,
+    )
+    run = Run(spec, launcher, tmp_path / "run")
+    result = run.execute()
+    assert result.state is RunState.FINISHED, result.reason
+    words = line(list(run.slots["through"].logs), "result")
+    assert words == ["result", "True", "remaining", "[2,", "1]"]
+    pose = run.sim.state.pose
+    assert math.hypot(pose.x - 3.0, pose.y - 2.2) <= 0.25
+    topics = {t["name"]: t for t in result.graph["topics"]}
+    assert topics["plan"]["messages"] == 1  # one path through both poses
