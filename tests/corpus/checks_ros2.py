@@ -240,11 +240,17 @@ def check_tb3_obstacle_avoider(outcome: Outcome) -> None:
 
 
 def check_tb3_stamped_stop(outcome: Outcome) -> None:
-    assert CORRIDOR_NORTH_WALL_Y_M - outcome.end.y == pytest.approx(0.35, abs=0.06)
+    # A 10 Hz timer acting on the last 5 Hz scan at 0.15 m/s: the robot stops 4-6 cm past the
+    # 0.35 m threshold (0.29 m in lockstep); a realtime run's late wake-ups may add a few more.
+    gap_m = CORRIDOR_NORTH_WALL_Y_M - outcome.end.y
+    closest_m = 0.23 if outcome.clock is Clock.REALTIME else 0.27
+    assert closest_m <= gap_m <= 0.35, gap_m
     assert_still_after(outcome, outcome.end.t - 1.0, within_m=0.04)
     assert_log(outcome, "tb3_stamped_stop", r"Stop! obstacle at 0\.3\d m")
-    commands = [message for _, message in outcome.messages("cmd_vel")]
+    # The node's commands, then the run's own zero at its end, in the type the node used.
+    *commands, last = [message for _, message in outcome.messages("cmd_vel")]
     assert commands and all(message.header.frame_id == "base_link" for message in commands)
+    assert last.twist.linear.x == last.twist.angular.z == 0.0
     stamps = [message.header.stamp.sec + message.header.stamp.nanosec / 1e9 for message in commands]
     assert stamps == sorted(stamps) and stamps[-1] - stamps[0] >= 4.0, stamps[:3]
     assert commands[0].twist.linear.x == pytest.approx(0.15)

@@ -34,11 +34,12 @@ class CrowbotPid(Node):
             return
         error = self.dr - DESIRED
         self.integral += error * T
+        self.integral = max(-0.05, min(0.05, self.integral))  # anti windup
         derivative = 0.0 if self.previous_error is None else (error - self.previous_error) / T
         self.previous_error = error
         u = KP * error + KI * self.integral + KD * derivative
         cmd = Twist()
-        cmd.linear.x = max(-0.2, min(0.2, u))
+        cmd.linear.x = max(-0.12, min(0.12, u))
         self.pub.publish(cmd)
         now = self.get_clock().now().nanoseconds / 1e9
         self.samples.append((now, error, cmd.linear.x))
