@@ -35,14 +35,7 @@ CORRIDOR_FACING_NORTH = (2.6, 3.1, math.pi / 2)  # [m, m, rad] 0.6 m from the co
 LANE_FOLLOWING = (2.6, 2.95, 0.0)  # [m, m, rad] 0.45 m left of the corridor's south wall
 
 
-# Pieces of issue 13 not on main yet (removed as they land).
-AWAITING: tuple[str, ...] = ()
-STAMPED_ZERO = "the run's final zero TwistStamped stamped with the node's frame_id"
-CHECK_REVIEW = "the case's script or check reviewed (rclpy runs it as written; see the report)"
-
-
 def ros2_case(case_id: str, robot: str, world: str, duration_s: float, check, **kwargs) -> Case:
-    kwargs.setdefault("needs", AWAITING)
     return Case(case_id, robot, world, duration_s, check, scripts=SCRIPTS_ROS2, **kwargs)
 
 
@@ -220,7 +213,6 @@ CASES = (
         checks.check_tb3_stamped_stop,
         nodes=(Node("tb3_stamped_stop.py"),),
         initial_pose=(2.6, 2.75, math.pi / 2),
-        needs=(STAMPED_ZERO,),
     ),
     ros2_case(
         "tb3_wall_follower",
@@ -238,7 +230,6 @@ CASES = (
         9.0,
         checks.check_crowbot_pid,
         nodes=(Node("crowbot_pid.py"),),
-        needs=(CHECK_REVIEW,),
     ),
     ros2_case(
         "ir_scout_node",
