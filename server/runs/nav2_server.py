@@ -13,10 +13,7 @@ client cancels it (CANCELED). Recoveries (spin, back up, wait) are not run: numb
 stays 0 and a failure ends the goal. `navigate_through_poses` plans leg by leg into one path;
 its number_of_poses_remaining counts the poses not yet passed within 0.5 m (RemovePassedGoals).
 
-`follow_waypoints` is Nav2's waypoint follower: a NavigateToPose goal per waypoint (visible on
-navigate_to_pose's status topic, as the follower is its client), a 200 ms pause at each
-(WaitAtWaypoint's default), and - `stop_on_failure` true by default - ABORTED with the missed
-waypoint when one fails.
+`follow_waypoints` is Nav2's waypoint follower (nav2_waypoints.py).
 
 Parameters (the run's params): `controller_frequency` [Hz] (Nav2's default 20), `controller_service`
 (a service a student node serves, robodojo_msgs/srv/ComputeVelocityCommands: the thesis's
@@ -40,6 +37,7 @@ from sandbox.services import request_topic
 from server.runs.builtin import BuiltinNode, Planner
 from server.runs.nav2_follow import GoalChecker, PurePursuit
 from server.runs.nav2_navigation import PLANNERS, Navigation, NoPath, Pose, plan_path, yaw_of
+from server.runs.nav2_waypoints import WaypointFollower
 from server.runs.nav2_wire import (
     SERVICE_CALL,
     ActionWire,
@@ -48,6 +46,7 @@ from server.runs.nav2_wire import (
     reply,
     stamp_ns,
     time_msg,
+    with_error,
 )
 
 if TYPE_CHECKING:
@@ -56,7 +55,6 @@ if TYPE_CHECKING:
 NS = 1_000_000_000
 CONTROLLER_FREQUENCY_HZ = 20.0  # [Hz] Nav2's controller_server default
 SERVICE_PATIENCE_S = 1.0  # [s] a goal waits this long for an unserved controller service
-WAYPOINT_PAUSE_S = 0.2  # [s] WaitAtWaypoint's waypoint_pause_duration default (200 ms)
 TURNING_RADIUS_M = 0.4  # [m] SMAC Hybrid-A*'s minimum_turning_radius default
 CONTROLLER_SERVICE_TYPE = "robodojo_msgs/srv/ComputeVelocityCommands"
 NAVIGATE = "navigate_to_pose"
@@ -89,46 +87,6 @@ def _twist(v: float, w: float) -> Any:
     twist = _msg("geometry_msgs/msg/Twist")
     twist.linear.x, twist.angular.z = float(v), float(w)
     return twist
-
-
-# Result error codes as Nav2 Jazzy's servers give them (bt_navigator passes on the code of the
-# server that failed: the planner's 2xx, the controller's 1xx, its own 9xxx).
-ERROR_CODES = {
-    "NONE": 0,
-    "PREEMPTED": 0,  # Nav2 aborts a preempted goal with an empty result
-    "INVALID_CONTROLLER": 101,  # FollowPath
-    "FAILED_TO_MAKE_PROGRESS": 105,
-    "NO_VALID_CONTROL": 106,
-    "PLANNER_TF_ERROR": 202,  # ComputePathToPose
-    "GOAL_OUTSIDE_MAP": 204,
-    "GOAL_OCCUPIED": 206,
-    "NO_VALID_PATH": 208,
-    "NO_VALID_WAYPOINTS": 602,  # FollowWaypoints
-    "UNKNOWN": 9000,  # NavigateToPose
-    "FAILED_TO_LOAD_BEHAVIOR_TREE": 9001,
-    "TF_ERROR": 9002,
-}
-
-
-def _with_error(result: Any, code_name: str, message: str) -> Any:
-    """Fill a Jazzy result's error_code and error_msg (results before Jazzy have neither)."""
-    fields = result.get_fields_and_field_types()
-    if "error_msg" in fields:
-        result.error_msg = message
-    if "error_code" in fields:
-        result.error_code = ERROR_CODES[code_name or "NONE"]
-    return result
-
-
-class Mission:
-    """One FollowWaypoints goal: which waypoint, which failed, when the pause ends."""
-
-    def __init__(self, goal: Goal, poses: list[Any], first: int, loops: int) -> None:
-        self.goal, self.poses, self.index, self.loops = goal, poses, first, loops
-        self.loop = 0
-        self.missed: list[tuple[int, int]] = []  # (waypoint index, error code)
-        self.nav_uuid: bytes | None = None
-        self.resume_ns = 0
 
 
 class NavigationServer(BuiltinNode):
@@ -186,7 +144,7 @@ class NavigationServer(BuiltinNode):
         self.follower = PurePursuit()
         self.pose: Pose | None = None
         self.current: Navigation | None = None
-        self.mission: Mission | None = None
+        self.waypoints = WaypointFollower(self)
         self.subscribes = ("pose",) + ((self.client.reply_topic,) if self.client else ())
         for wire in (self.navigate, self.through, self.follow, self.compute):
             for topic, type_name in wire.published:
@@ -232,7 +190,7 @@ class NavigationServer(BuiltinNode):
         if wire in (self.navigate, self.through):
             out += self._start_navigation(run, goal, wire)
         elif wire is self.follow:
-            out += self._start_mission(run, goal)
+            out += self.waypoints.start(run, goal)
         else:
             out += self._compute_path(run, goal)
         return out
@@ -251,7 +209,7 @@ class NavigationServer(BuiltinNode):
             points, yaws = self._plan(begin or self.pose, target)
         except NoPath as error:
             code = "PLANNER_TF_ERROR" if error.code == "TF_ERROR" else error.code
-            _with_error(result, code, str(error))
+            with_error(result, code, str(error))
             return self._end(run, self.compute, goal, GoalEvent.ABORT, result, str(error))
         result.path = self._path_message(points, yaws, run.time_ns)
         return self._end(run, self.compute, goal, GoalEvent.SUCCEED, result)
@@ -282,12 +240,8 @@ class NavigationServer(BuiltinNode):
         if canceling:
             out.append(wire.status())
         for goal in canceling:
-            if wire is self.follow and self.mission is not None and self.mission.goal is goal:
-                mission, self.mission = self.mission, None
-                out += self._cancel_navigation(run, mission.nav_uuid)
-                out += self._end(
-                    run, self.follow, goal, GoalEvent.CANCELED, self._mission_result(mission)
-                )
+            if wire is self.follow:
+                out += self.waypoints.cancel(run, goal)
             elif wire in (self.navigate, self.through):
                 out += self._cancel_navigation(run, goal.uuid, wire)
         return out
@@ -362,9 +316,9 @@ class NavigationServer(BuiltinNode):
         self, run: Run, goal: Goal, code: str, message: str, wire: ActionWire | None = None
     ) -> list:
         wire = wire or self.navigate
-        result = _with_error(wire.action.Result(), code, message)
+        result = with_error(wire.action.Result(), code, message)
         out = self._end(run, wire, goal, GoalEvent.ABORT, result, message)
-        return out + self._mission_step(run, goal, GoalStatus.ABORTED, result)
+        return out + self.waypoints.navigation_ended(run, goal, GoalStatus.ABORTED, result)
 
     def _finish_navigation(self, run: Run, event: GoalEvent, code: str, message: str) -> list:
         nav, self.current = self.current, None
@@ -372,13 +326,13 @@ class NavigationServer(BuiltinNode):
             return []
         wire = nav.wire
         goal = wire.goals.goals[nav.uuid]
-        result = _with_error(wire.action.Result(), code, message if code else "")
+        result = with_error(wire.action.Result(), code, message if code else "")
         out = [(run.velocity_topic, _twist(0.0, 0.0))]
         if message and event is not GoalEvent.SUCCEED:
             self.log(run, "WARN" if event is GoalEvent.ABORT else "INFO",
                      f"{wire.name}: {message}")  # fmt: skip
         out += self._end(run, wire, goal, event, result, message)
-        return out + self._mission_step(run, goal, goal.status, result)
+        return out + self.waypoints.navigation_ended(run, goal, goal.status, result)
 
     def _end(self, run: Run, wire: ActionWire, goal: Goal, event: GoalEvent, result: Any,
              message: str = "") -> list:  # fmt: skip
@@ -390,7 +344,7 @@ class NavigationServer(BuiltinNode):
 
     # ------------------------------------------------------------------ control
     def tick(self, run: Run) -> list[tuple[str, object]]:
-        out = self._mission_resume(run)
+        out = self.waypoints.resume(run)
         nav = self.current
         if nav is None or self.pose is None:
             return out
@@ -470,89 +424,3 @@ class NavigationServer(BuiltinNode):
             )  # fmt: skip
         twist = response.cmd_vel
         return [(run.velocity_topic, _twist(twist.linear.x, twist.angular.z))]
-
-    # ------------------------------------------------------------------ waypoints
-    def _start_mission(self, run: Run, goal: Goal) -> list:
-        out = []
-        if self.mission is not None:  # the waypoint follower takes the new goal instead
-            old, self.mission = self.mission, None
-            out += self._end(run, self.follow, old.goal, GoalEvent.ABORT, self._mission_result(old))
-            out += self._cancel_navigation(run, old.nav_uuid)
-        request = goal.request
-        poses = list(request.poses)
-        first = int(getattr(request, "goal_index", 0))
-        loops = int(getattr(request, "number_of_loops", 0))
-        mission = Mission(goal, poses, first, loops)
-        if not poses or first >= len(poses):
-            result = _with_error(
-                self.follow.action.Result(), "NO_VALID_WAYPOINTS", "no waypoints to follow"
-            )
-            return out + self._end(run, self.follow, goal, GoalEvent.ABORT, result)
-        self.mission = mission
-        return out + self._mission_goal(run)
-
-    def _mission_goal(self, run: Run) -> list:
-        mission = self.mission
-        uuid = _uuid(mission, run)
-        target = mission.poses[mission.index]
-        request = self.navigate.action.Goal(pose=target)
-        goal = self.navigate.goals.accept(uuid, run.time_ns, request)
-        goal.update(GoalEvent.EXECUTE)
-        mission.nav_uuid = uuid
-        feedback = self.follow.action.Feedback(current_waypoint=mission.index)
-        return [
-            self.navigate.status(),
-            self.follow.feedback(mission.goal.uuid, feedback),
-            *self._start_navigation(run, goal),
-        ]
-
-    def _mission_step(self, run: Run, goal: Goal, status: GoalStatus, result: Any) -> list:
-        """A navigation ended: if it was the mission's, note it and go on after the pause."""
-        mission = self.mission
-        if mission is None or goal.uuid != mission.nav_uuid:
-            return []
-        mission.nav_uuid = None
-        if status is GoalStatus.SUCCEEDED:
-            mission.resume_ns = run.time_ns + round(WAYPOINT_PAUSE_S * NS)
-            return []
-        mission.missed.append((mission.index, int(getattr(result, "error_code", 0))))
-        if self.stop_on_failure or status is GoalStatus.CANCELED:
-            self.mission = None
-            return self._end(
-                run, self.follow, mission.goal, GoalEvent.ABORT, self._mission_result(mission)
-            )
-        mission.resume_ns = run.time_ns
-        return []
-
-    def _mission_resume(self, run: Run) -> list:
-        mission = self.mission
-        if mission is None or mission.nav_uuid is not None or run.time_ns < mission.resume_ns:
-            return []
-        mission.index += 1
-        if mission.index >= len(mission.poses):
-            if mission.loop >= mission.loops:
-                self.mission = None
-                result = self._mission_result(mission)
-                return self._end(run, self.follow, mission.goal, GoalEvent.SUCCEED, result)
-            mission.index, mission.loop = 0, mission.loop + 1
-        return self._mission_goal(run)
-
-    def _mission_result(self, mission: Mission) -> Any:
-        result = self.follow.action.Result()
-        fields = result.get_fields_and_field_types()
-        if fields.get("missed_waypoints", "").startswith("sequence<int32"):
-            result.missed_waypoints = [index for index, _ in mission.missed]  # Humble
-        else:
-            missed = get_message_class("nav2_msgs/msg/MissedWaypoint")
-            result.missed_waypoints = [
-                missed(index=index, goal=mission.poses[index], error_code=code)
-                for index, code in mission.missed
-            ]
-        return result
-
-
-def _uuid(mission: Mission, run: Run) -> bytes:
-    """A goal id for the waypoint follower's own NavigateToPose goals: unique in the run and
-    the same from run to run (lockstep runs repeat byte for byte)."""
-    counter = run.time_ns.to_bytes(8, "big") + mission.index.to_bytes(4, "big")
-    return b"wp" + mission.goal.uuid[:2] + counter

@@ -28,6 +28,35 @@ SERVICE_REPLY = "robodojo_msgs/msg/ServiceReply"
 STATUS_TYPE = "action_msgs/msg/GoalStatusArray"
 
 
+# Result error codes as Nav2 Jazzy's servers give them (bt_navigator passes on the code of the
+# server that failed: the planner's 2xx, the controller's 1xx, its own 9xxx).
+ERROR_CODES = {
+    "NONE": 0,
+    "PREEMPTED": 0,  # Nav2 aborts a preempted goal with an empty result
+    "INVALID_CONTROLLER": 101,  # FollowPath
+    "FAILED_TO_MAKE_PROGRESS": 105,
+    "NO_VALID_CONTROL": 106,
+    "PLANNER_TF_ERROR": 202,  # ComputePathToPose
+    "GOAL_OUTSIDE_MAP": 204,
+    "GOAL_OCCUPIED": 206,
+    "NO_VALID_PATH": 208,
+    "NO_VALID_WAYPOINTS": 602,  # FollowWaypoints
+    "UNKNOWN": 9000,  # NavigateToPose
+    "FAILED_TO_LOAD_BEHAVIOR_TREE": 9001,
+    "TF_ERROR": 9002,
+}
+
+
+def with_error(result: Any, code_name: str, message: str) -> Any:
+    """Fill a Jazzy result's error_code and error_msg (results before Jazzy have neither)."""
+    fields = result.get_fields_and_field_types()
+    if "error_msg" in fields:
+        result.error_msg = message
+    if "error_code" in fields:
+        result.error_code = ERROR_CODES[code_name or "NONE"]
+    return result
+
+
 def time_msg(time_ns: int) -> Any:
     return get_message_class("builtin_interfaces/msg/Time")(sec=time_ns // NS, nanosec=time_ns % NS)
 
