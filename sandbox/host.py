@@ -51,8 +51,9 @@ class Link(Protocol):
 
 def _forget_modules_from(directory: str) -> None:
     """Drop the modules imported from `directory` (the other dialect's layer), so that
-    `std_msgs.msg` means this dialect's package. A sandboxed child runs one node; this matters
-    where one process runs nodes of both dialects in turn (the tests)."""
+    `std_msgs.msg` means this dialect's package and `import rclpy` in a ROS 1 node fails with
+    its sentence: the runner imports rclpy ahead for every node, and one process may run nodes
+    of both dialects in turn (the tests)."""
     prefix = directory + os.sep
     for name, module in list(sys.modules.items()):
         path = getattr(module, "__file__", None) or ""
@@ -68,7 +69,7 @@ def install_ros_compat(ros_version: int = 1) -> None:
     )
     if other in sys.path:
         sys.path[:] = [entry for entry in sys.path if entry != other]
-        _forget_modules_from(other)
+    _forget_modules_from(other)  # imported ahead by the runner, or by an earlier node
     if ours not in sys.path:
         sys.path.insert(0, ours)
     # Modules we lack fail with a sentence for this dialect, not "No module named".

@@ -51,20 +51,30 @@ class ProcessState:
         self.main_thread = node_runtime._main_thread
         node_runtime.after_wake.append(self._check_graph_qos)
         node_runtime.after_wake.append(self._run_background)
+        node_runtime.after_wake.append(self._run_interleaved)
         self._graph_seen: object = None
         node_runtime.due_hooks.append(self._background_due_ns)
         node_runtime.on_shutdown(self._on_runtime_shutdown)
 
     # ------------------------------------------------------------------ background spins
+    def _interleaving(self) -> list[Executor]:
+        """MultiThreadedExecutors with a callback running now: their other callbacks may run
+        while it sleeps (_run_interleaved), so their timers and topics wake the node."""
+        found: list[Executor] = []
+        for _, executor in self.executing:
+            if getattr(executor, "_num_threads", 1) >= 2 and executor not in found:
+                found.append(executor)  # type: ignore[arg-type]
+        return found
+
     def _background_due_ns(self) -> int | None:
-        due = [executor._next_due_ns() for executor in self.background]
+        due = [executor._next_due_ns() for executor in (*self.background, *self._interleaving())]
         due = [value for value in due if value is not None]
         return min(due) if due else None
 
     def refresh_wake_topics(self) -> None:
         """The runtime wakes early for every topic a background executor's entities read."""
         wanted: set[str] = set()
-        for executor in self.background:
+        for executor in (*self.background, *self._interleaving()):
             wanted |= executor._wake_topics()
         previous: set[str] = getattr(self, "_background_topics", set())
         self.runtime.wake_topics -= previous - wanted
@@ -95,6 +105,21 @@ class ProcessState:
                 topic = by_name.get(subscription._bus_topic)
                 if topic is not None:
                     subscription._check_graph(topic, own_label)
+
+    def _run_interleaved(self) -> None:
+        """A callback of a MultiThreadedExecutor is sleeping (time.sleep, a rate, a clock): at
+        each wake meanwhile, the executor's other ready callbacks run where their callback
+        groups allow, as rclpy's other worker threads would run them (at most as many at once
+        as the executor has threads)."""
+        if not self.executing:
+            return
+        _, executor = self.executing[-1]
+        threads = getattr(executor, "_num_threads", 1)
+        if executor is None or threads < 2:
+            return
+        if sum(1 for _, running in self.executing if running is executor) >= threads:
+            return
+        executor._run_ready_pass()
 
     def _on_runtime_shutdown(self) -> None:
         for context in list(self.contexts):
@@ -167,10 +192,15 @@ class ProcessState:
         self, group: CallbackGroup | None, executor: Executor | None = None
     ) -> Iterator[None]:
         self.executing.append((group, executor))
+        interleaving = getattr(executor, "_num_threads", 1) >= 2
+        if interleaving:
+            self.refresh_wake_topics()
         try:
             yield
         finally:
             self.executing.pop()
+            if interleaving:
+                self.refresh_wake_topics()
 
     def on_node_thread(self) -> bool:
         return threading.get_ident() == self.main_thread

@@ -25,6 +25,7 @@ of the node's waits (rclpy/_state.py).
 from __future__ import annotations
 
 import inspect
+import os
 import threading
 import warnings
 from collections.abc import Callable
@@ -217,11 +218,11 @@ class Executor:
 
     # ------------------------------------------------------------------ work
     def _next_due_ns(self) -> int | None:
-        due = [
+        due = [  # a timer whose group is busy (its callback sleeping) cannot run: no wake
             entity._due_ns()
             for node in self._nodes
             for entity in node._entities()
-            if hasattr(entity, "_due_ns")
+            if hasattr(entity, "_due_ns") and _group_allows(entity)
         ]
         due = [value for value in due if value is not None]
         return min(due) if due else None
@@ -333,8 +334,14 @@ class Executor:
         if not self._context.ok() or self._is_shutdown:
             self._release_background()
             return
-        snapshot = self._collect_ready()
-        self._snapshot = snapshot
+        self._run_ready_pass()
+
+    def _run_ready_pass(self) -> None:
+        """Run each callback that is ready now and whose group allows it, once; an exception
+        ends the node (it has no caller of the student's to go to)."""
+        if not self._context.ok() or self._is_shutdown:
+            return
+        self._snapshot = self._collect_ready()
         while self._snapshot:
             work = self._next_work()
             if work is None:
@@ -364,8 +371,9 @@ class MultiThreadedExecutor(Executor):
 
     def __init__(self, num_threads: int | None = None, *, context: Context | None = None) -> None:
         super().__init__(context=context)
-        if num_threads is None:
-            num_threads = 2
+        if num_threads is None:  # rclpy: the CPUs this process may use
+            num_threads = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else 2
+            num_threads = max(num_threads, 2)
         if num_threads == 1:
             warnings.warn(
                 "MultiThreadedExecutor is used with a single thread.\n"

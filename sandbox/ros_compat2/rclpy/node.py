@@ -103,7 +103,7 @@ class Node:
         self._default_callback_group = MutuallyExclusiveCallbackGroup()
         self._rate_group = ReentrantCallbackGroup()
         self._executor: Executor | None = None
-        self._destroyed = False
+        self.__destroyed = False
 
         local_args = parse_arguments(list(cli_args)) if cli_args else ros2_args.RosArguments()
         info = current.runtime.info
@@ -111,12 +111,12 @@ class Node:
         if info.namespace not in ("", "/"):
             launch_rules.append(RemapRule("__ns", info.namespace))
         global_args = self._context.arguments if use_global_arguments else ros2_args.RosArguments()
-        self._remaps = [*local_args.remaps, *global_args.remaps, *launch_rules]
+        self.__remaps = [*local_args.remaps, *global_args.remaps, *launch_rules]
         try:
             validate_node_name(node_name)
             namespace = normalize_namespace(namespace)
-            self._name, self._namespace = node_name_and_namespace(
-                self._remaps, node_name, namespace
+            self.__name, self.__namespace = node_name_and_namespace(
+                self.__remaps, node_name, namespace
             )
         except Ros2NameError as error:
             raise _name_exception(error) from None
@@ -131,8 +131,8 @@ class Node:
 
         overrides = {
             **_flat_launch_params(info.params),
-            **global_args.parameters_for(self._name, self._namespace),
-            **local_args.parameters_for(self._name, self._namespace),
+            **global_args.parameters_for(self.__name, self.__namespace),
+            **local_args.parameters_for(self.__name, self.__namespace),
         }
         self._parameters = ParameterStore(self, overrides, allow_undeclared_parameters)
         if parameter_overrides is not None:
@@ -149,17 +149,17 @@ class Node:
 
     # ------------------------------------------------------------------ identity
     def _logger_name(self) -> str:
-        parts = [part for part in self._namespace.split("/") if part]
-        return ".".join([*parts, self._name])
+        parts = [part for part in self.__namespace.split("/") if part]
+        return ".".join([*parts, self.__name])
 
     def get_name(self) -> str:
-        return self._name
+        return self.__name
 
     def get_namespace(self) -> str:
-        return self._namespace
+        return self.__namespace
 
     def get_fully_qualified_name(self) -> str:
-        return self._namespace.rstrip("/") + "/" + self._name
+        return self.__namespace.rstrip("/") + "/" + self.__name
 
     def get_clock(self) -> Clock:
         return self._clock
@@ -241,10 +241,10 @@ class Node:
         if not isinstance(name, str):
             raise TypeError(f"a {kind} is a string such as 'cmd_vel', got {name!r}")
         try:
-            expanded = expand_topic_name(name, self._name, self._namespace, kind)
+            expanded = expand_topic_name(name, self.__name, self.__namespace, kind)
             if only_expand:
                 return expanded
-            return remap_topic_name(self._remaps, expanded, self._name, self._namespace)
+            return remap_topic_name(self.__remaps, expanded, self.__name, self.__namespace)
         except Ros2NameError as error:
             raise _name_exception(error) from None
 
@@ -253,8 +253,8 @@ class Node:
 
     # ------------------------------------------------------------------ entities
     def _check_alive(self, what: str) -> None:
-        if self._destroyed:
-            raise RuntimeError(f"{what} on node '{self._name}' after destroy_node()")
+        if self.__destroyed:
+            raise RuntimeError(f"{what} on node '{self.__name}' after destroy_node()")
 
     @staticmethod
     def _validate_qos_or_depth_parameter(qos_or_depth: Any) -> QoSProfile:
@@ -454,7 +454,7 @@ class Node:
 
     def destroy_node(self) -> None:
         """Free the node's publishers, subscriptions, clients, services and timers."""
-        if self._destroyed:
+        if self.__destroyed:
             return
         self._context.untrack_node(self)
         for entities in (
@@ -468,7 +468,7 @@ class Node:
             while entities:
                 entities.pop(0).destroy()
         self._waitables.clear()
-        self._destroyed = True
+        self.__destroyed = True
         current = _state.state()
         if self in current.nodes:
             current.nodes.remove(self)

@@ -94,6 +94,9 @@ QoSDurabilityPolicy = DurabilityPolicy
 QoSLivelinessPolicy = LivelinessPolicy
 
 DEPTH_SYSTEM_DEFAULT = 0
+# [messages] what a KEEP_ALL subscription holds at most: DDS bounds KEEP_ALL by its resource
+# limits too, and a node that never spins must not grow without bound
+KEEP_ALL_LIMIT = 1000
 _DEFAULTS: dict[str, Any] = {  # rmw's qos_profile_default
     "depth": 10,
     "reliability": ReliabilityPolicy.RELIABLE,
@@ -261,10 +264,10 @@ class QoSProfile:
     __repr__ = __str__
 
     # What a RoboDojo node does with the profile (module docstring).
-    def queue_limit(self) -> int | None:
-        """How many unread messages a subscription keeps (None: all of them)."""
+    def queue_limit(self) -> int:
+        """How many unread messages a subscription keeps."""
         if self.history == HistoryPolicy.KEEP_ALL:
-            return None
+            return KEEP_ALL_LIMIT
         return self.depth if self.depth > 0 else _DEFAULTS["depth"]
 
     def effective_reliability(self) -> ReliabilityPolicy:
