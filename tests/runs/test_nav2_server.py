@@ -398,3 +398,50 @@ def test_navigate_through_poses_passes_each_and_counts_them_down(tmp_path, launc
     assert math.hypot(pose.x - 3.0, pose.y - 2.2) <= 0.25
     topics = {t["name"]: t for t in result.graph["topics"]}
     assert topics["plan"]["messages"] == 1  # one path through both poses
+
+
+GET_PATH = """
+import rclpy
+from geometry_msgs.msg import PoseStamped
+from nav2_simple_commander.robot_navigator import BasicNavigator
+
+
+def pose(x, y):
+    p = PoseStamped()
+    p.header.frame_id = "map"
+    p.pose.position.x, p.pose.position.y = x, y
+    p.pose.orientation.w = 1.0
+    return p
+
+
+rclpy.init()
+navigator = BasicNavigator()
+navigator.waitUntilNav2Active()
+path = navigator.getPath(pose(2.0, 1.3), pose(3.0, 2.2))
+end = path.poses[-1].pose.position
+print("path", len(path.poses), round(end.x, 2), round(end.y, 2))
+print("wall", navigator.getPath(pose(2.0, 1.3), pose(0.5, 0.5)))
+rclpy.shutdown()
+"""
+
+
+def test_get_path_plans_without_driving_and_says_none_for_a_wall(tmp_path, launcher):
+    spec = RunSpec(
+        "turtlebot",
+        "office",
+        (NodeSpec("planner", GET_PATH, "get_path.py"),),
+        clock=Clock.LOCKSTEP,
+        duration_s=5.0,
+        spawn="start",
+        builtin_nodes=NAV2,
+    )
+    run = Run(spec, launcher, tmp_path / "run")
+    result = run.execute()
+    assert result.state is RunState.FINISHED, result.reason
+    lines = list(run.slots["planner"].logs)
+    _, count, x, y = line(lines, "path")
+    assert int(count) > 15 and (x, y) == ("3.0", "2.2")
+    assert line(lines, "wall") == ["wall", "None"]
+    assert run.sim.state.distance_travelled_m == 0.0  # planning only
+    topics = {t["name"]: t for t in result.graph["topics"]}
+    assert "plan" not in topics or topics["plan"]["messages"] == 0
