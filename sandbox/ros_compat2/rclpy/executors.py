@@ -14,10 +14,11 @@ As rclpy/executors.py, where a student can observe it:
 - An exception in a callback comes out of spin, as in rclpy.
 
 Where this differs from real threads: a MultiThreadedExecutor runs its callbacks one at a time
-on the node's thread. While one blocks in Client.call() or spin_until_future_complete(), the
-others run in between if their callback group allows (a ReentrantCallbackGroup, or another
-group than the blocked callback's), as rclpy's worker threads would run them. A callback that
-sleeps (time.sleep) lets time pass but no other callback run meanwhile.
+on the node's thread. While one blocks in Client.call(), spin_until_future_complete() or a
+sleep (time.sleep, a Rate: _state.ProcessState._run_interleaved), the others run in between if
+their callback group allows (a ReentrantCallbackGroup, or another group than the blocked
+callback's), as rclpy's worker threads would run them. Under a SingleThreadedExecutor a
+callback that sleeps lets time pass and no other callback run, as in rclpy.
 An executor spun from a thread of the student's runs its callbacks on the node's thread at each
 of the node's waits (rclpy/_state.py).
 """
