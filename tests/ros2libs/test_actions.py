@@ -156,6 +156,26 @@ rclpy.shutdown()
 """
 
 
+# ros2/examples' minimal_action_server: the execute callback sleeps, a MultiThreadedExecutor and a
+# ReentrantCallbackGroup let the cancel request in meanwhile.
+MULTI_THREADED_SERVER = (
+    SERVER.replace(
+        "rclpy.spin(Server())",
+        "rclpy.spin(Server(), executor=MultiThreadedExecutor())",
+    )
+    .replace(
+        "goal_callback=self.on_goal,",
+        "goal_callback=self.on_goal, callback_group=ReentrantCallbackGroup(),",
+    )
+    .replace(
+        "from rclpy.node import Node",
+        "from rclpy.node import Node\n"
+        "from rclpy.callback_groups import ReentrantCallbackGroup\n"
+        "from rclpy.executors import MultiThreadedExecutor",
+    )
+)
+
+
 def run_fibonacci(
     launcher,
     out_dir: Path,
@@ -166,11 +186,11 @@ def run_fibonacci(
     forget_to_succeed: bool = False,
     clock: Clock = Clock.LOCKSTEP,
     stepping: bool = False,
+    multi_threaded: bool = False,
 ):
-    server = (
-        (STEPPING_SERVER if stepping else SERVER)
-        .replace("ACCEPT_CANCEL", repr(accept_cancel))
-        .replace("FORGET_TO_SUCCEED", repr(forget_to_succeed))
+    base = STEPPING_SERVER if stepping else MULTI_THREADED_SERVER if multi_threaded else SERVER
+    server = base.replace("ACCEPT_CANCEL", repr(accept_cancel)).replace(
+        "FORGET_TO_SUCCEED", repr(forget_to_succeed)
     )
     client = CLIENT.replace("CANCEL_AFTER", repr(cancel_after)).replace("ORDER", repr(order))
     return run_nodes(
@@ -207,6 +227,20 @@ def test_a_cancel_the_server_accepts_ends_the_goal_canceled(launcher, tmp_path: 
     assert re.search(r"result status=5 sequence=\[0, 1, 1, 2(, 3)?\]", client), client
     assert "canceled" in outcome.log("fibonacci_server")
     assert len(feedback_lines(client)) <= 3
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="rclpy in the sandbox: a callback sleeping (time.sleep) under a MultiThreadedExecutor "
+    "runs no other callback meanwhile, where rclpy's other threads would take the cancel request",
+)
+def test_a_sleeping_execute_callback_takes_a_cancel_under_a_multi_threaded_executor(
+    launcher, tmp_path: Path
+) -> None:
+    outcome = run_fibonacci(launcher, tmp_path, order=15, cancel_after=2, multi_threaded=True)
+    client = outcome.log("fibonacci_client")
+    assert "accepted=True" in client, outcome.describe()
+    assert "cancel code=0 canceling=1" in client and "result status=5" in client
 
 
 def test_the_default_cancel_callback_refuses_and_the_goal_finishes(

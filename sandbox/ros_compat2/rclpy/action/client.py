@@ -115,20 +115,34 @@ class ActionClient:
         self._logger = wire.child_logger(node, "action_client")
         names = wire.names(action_name)
         impl = action_type.Impl
-        self._goal_client = node.create_client(impl.SendGoalService, names["send_goal"])
-        self._result_client = node.create_client(impl.GetResultService, names["get_result"])
-        self._cancel_client = node.create_client(impl.CancelGoalService, names["cancel_goal"])
+        group = callback_group  # rclpy puts the whole action client in one group
+
+        def client(srv_type: Any, name: str, qos: Any) -> Any:
+            extra = {} if qos is None else {"qos_profile": qos}
+            return node.create_client(srv_type, name, callback_group=group, **extra)
+
+        self._goal_client = client(
+            impl.SendGoalService, names["send_goal"], goal_service_qos_profile
+        )
+        self._result_client = client(
+            impl.GetResultService, names["get_result"], result_service_qos_profile
+        )
+        self._cancel_client = client(
+            impl.CancelGoalService, names["cancel_goal"], cancel_service_qos_profile
+        )
         self._feedback_sub = node.create_subscription(
             impl.FeedbackMessage,
             names["feedback"],
             self._on_feedback,
             feedback_sub_qos_profile or wire.FEEDBACK_DEPTH,
+            callback_group=group,
         )
         self._status_sub = node.create_subscription(
             impl.GoalStatusMessage,
             names["status"],
             self._on_status,
             status_sub_qos_profile or wire.status_qos(),
+            callback_group=group,
         )
         self._goal_handles: dict[bytes, ClientGoalHandle] = {}
         self._feedback_callbacks: dict[bytes, Any] = {}

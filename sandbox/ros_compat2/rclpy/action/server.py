@@ -33,6 +33,11 @@ from . import wire
 RESULT_TIMEOUT_S = 10  # [s] rclpy's ActionServer(result_timeout=10): how long results are kept
 
 
+def _qos(profile: Any) -> dict[str, Any]:
+    """A service's qos_profile keyword, when one was given."""
+    return {} if profile is None else {"qos_profile": profile}
+
+
 class GoalResponse(Enum):
     """What a goal_callback returns."""
 
@@ -182,10 +187,29 @@ class ActionServer:
         self._logger = wire.child_logger(node, "action_server")
         names = wire.names(action_name)
         impl = action_type.Impl
+        group = callback_group  # rclpy puts the whole action server in one group
         self._services = [
-            node.create_service(impl.SendGoalService, names["send_goal"], self._on_send_goal),
-            node.create_service(impl.GetResultService, names["get_result"], self._on_get_result),
-            node.create_service(impl.CancelGoalService, names["cancel_goal"], self._on_cancel),
+            node.create_service(
+                impl.SendGoalService,
+                names["send_goal"],
+                self._on_send_goal,
+                callback_group=group,
+                **_qos(goal_service_qos_profile),
+            ),
+            node.create_service(
+                impl.GetResultService,
+                names["get_result"],
+                self._on_get_result,
+                callback_group=group,
+                **_qos(result_service_qos_profile),
+            ),
+            node.create_service(
+                impl.CancelGoalService,
+                names["cancel_goal"],
+                self._on_cancel,
+                callback_group=group,
+                **_qos(cancel_service_qos_profile),
+            ),
         ]
         self._feedback_publisher = node.create_publisher(
             impl.FeedbackMessage, names["feedback"], feedback_pub_qos_profile or wire.FEEDBACK_DEPTH
