@@ -137,7 +137,9 @@ class NavigationServer(BuiltinNode):
         )
         service = params.get("controller_service")
         self.client = (
-            ServiceClient(str(service), get_service_class(CONTROLLER_SERVICE_TYPE), self.name)
+            ServiceClient(
+                str(service).strip("/"), get_service_class(CONTROLLER_SERVICE_TYPE), self.name
+            )
             if service
             else None
         )
