@@ -37,8 +37,9 @@ def _isalnum(char: str) -> bool:
 
 
 def validate_topic_name(name: str, kind: str = "topic name") -> None:
-    """rcl_validate_topic_name: a name before expansion (relative, absolute or private)."""
-    word = kind.split()[0]
+    """rcl_validate_topic_name: a name before expansion (relative, absolute or private). The
+    reasons say "topic name" for services too, as rcl's do."""
+    word = "topic"
     if not name:
         raise Ros2NameError(kind, name, f"{word} name must not be empty string", 0)
     if name[0].isdigit():
@@ -108,7 +109,7 @@ _UNMATCHED = "{word} name must not have unmatched (unbalanced) curly braces '{{}
 
 def validate_full_topic_name(name: str, kind: str = "topic name") -> None:
     """rmw_validate_full_topic_name: an expanded name (absolute, no repeated '/')."""
-    word = kind.split()[0]
+    word = "topic"
     if not name.startswith(SEP):
         raise Ros2NameError(kind, name, f"{word} name must be absolute, it must lead with a '/'", 0)
     double = name.find(SEP + SEP)

@@ -241,3 +241,30 @@ for line in got:
         "transient go north",
     ]
     assert "offering incompatible QoS" in capsys.readouterr().out
+
+
+def test_an_incompatible_qos_callback_replaces_the_warning(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    code = """
+import rclpy
+from rclpy.event_handler import SubscriptionEventCallbacks
+from rclpy.node import Node
+from rclpy.qos import qos_profile_sensor_data
+from std_msgs.msg import String
+
+rclpy.init()
+node = Node('careful')
+events = []
+callbacks = SubscriptionEventCallbacks(
+    incompatible_qos=lambda event: events.append((event.total_count, event.last_policy_kind)))
+node.create_subscription(String, 'fast', lambda m: None, 10, event_callbacks=callbacks)
+node.create_publisher(String, 'fast', qos_profile_sensor_data)
+node.create_publisher(String, 'report', 10).publish(String(data=repr(events)))
+"""
+    _, exited, _ = run(code, tmp_path)
+    assert exited.outcome is Outcome.FINISHED, exited.error
+    assert [m.data for m in published([], exited, "report")] == ["[(1, 16)]"]  # RELIABILITY
+    out = capsys.readouterr().out
+    assert "offering incompatible QoS" not in out
+    assert "requesting incompatible QoS" in out  # the publisher keeps rclpy's default

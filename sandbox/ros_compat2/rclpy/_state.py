@@ -177,11 +177,7 @@ class ProcessState:
         for pub, sub in pairs:
             kind = self._incompatible(pub, sub)
             if kind is not None:
-                pub._node.get_logger().warning(
-                    f"New subscription discovered on topic '{pub.topic_name}', requesting "
-                    "incompatible QoS. No messages will be sent to it. Last incompatible "
-                    f"policy: {_policy_name(kind)}"
-                )
+                pub._incompatible_qos.report(kind)
                 sub._warn_incompatible(pub._node.get_fully_qualified_name(), kind)
             elif subscription is not None and pub._last is not None and sub.transient_local:
                 sub._put(type(pub._last).deserialize(pub._last.serialize()))
@@ -245,12 +241,6 @@ def note_spin_thread(thread: threading.Thread) -> None:
     state().spin_threads.add(thread)
     if threading.Thread.join is not _join:
         threading.Thread.join = _join  # type: ignore[method-assign]
-
-
-def _policy_name(kind: int) -> str:
-    from .qos import qos_policy_name_from_kind
-
-    return qos_policy_name_from_kind(kind)
 
 
 def state() -> ProcessState:

@@ -296,7 +296,7 @@ class Node:
         self._check_msg_type(msg_type, "create_publisher()")
         bus_topic = self._bus(topic)
         try:
-            publisher = publisher_class(self, msg_type, topic, bus_topic, qos)
+            publisher = publisher_class(self, msg_type, topic, bus_topic, qos, event_callbacks)
         except ROSException as error:
             raise RuntimeError(str(error)) from None
         self._publishers.append(publisher)
@@ -323,7 +323,9 @@ class Node:
         group = callback_group or self._default_callback_group
         bus_topic = self._bus(topic)
         try:
-            subscription = Subscription(self, msg_type, topic, bus_topic, callback, group, qos, raw)
+            subscription = Subscription(
+                self, msg_type, topic, bus_topic, callback, group, qos, raw, event_callbacks
+            )
         except ROSException as error:
             raise RuntimeError(str(error)) from None
         group.add_entity(subscription)

@@ -16,8 +16,9 @@ from typing import TYPE_CHECKING, Any
 from sandbox.protocol import Envelope
 
 from . import _state
+from .event_handler import IncompatibleQoSReporter
 from .exceptions import InvalidHandle
-from .qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from .qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy, qos_policy_name_from_kind
 
 if TYPE_CHECKING:
     from .node import Node
@@ -27,9 +28,18 @@ class Publisher:
     """Sends messages of one type on one topic (made by Node.create_publisher)."""
 
     def __init__(
-        self, node: Node, msg_type: type, topic: str, bus_topic: str, qos_profile: QoSProfile
+        self,
+        node: Node,
+        msg_type: type,
+        topic: str,
+        bus_topic: str,
+        qos_profile: QoSProfile,
+        event_callbacks: Any = None,
     ) -> None:
         self.msg_type = msg_type
+        self._incompatible_qos = IncompatibleQoSReporter(
+            event_callbacks, self._default_incompatible_qos
+        )
         self.topic = topic  # as given
         self.qos_profile = qos_profile
         self._node = node
@@ -68,6 +78,14 @@ class Publisher:
         if self.durability == DurabilityPolicy.TRANSIENT_LOCAL:
             self._last = msg
         _state.state().deliver_locally(self, msg)
+
+    def _default_incompatible_qos(self, policy_kind: int) -> None:
+        """rclpy's default callback for the event (rclpy/event_handler.py)."""
+        self._node.get_logger().warning(
+            f"New subscription discovered on topic '{self.topic_name}', requesting incompatible "
+            "QoS. No messages will be sent to it. Last incompatible policy: "
+            f"{qos_policy_name_from_kind(policy_kind)}"
+        )
 
     def get_subscription_count(self) -> int:
         return self._node._count_on_graph(self._bus_topic, subscribers=True)

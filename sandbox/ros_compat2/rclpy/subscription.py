@@ -15,6 +15,7 @@ from enum import Enum
 from typing import TYPE_CHECKING, Any
 
 from . import _state
+from .event_handler import IncompatibleQoSReporter
 from .exceptions import InvalidHandle
 from .qos import (
     DurabilityPolicy,
@@ -46,8 +47,12 @@ class Subscription:
         callback_group: CallbackGroup,
         qos_profile: QoSProfile,
         raw: bool = False,
+        event_callbacks: Any = None,
     ) -> None:
         self.msg_type = msg_type
+        self._incompatible_qos = IncompatibleQoSReporter(
+            event_callbacks, self._default_incompatible_qos
+        )
         self.topic = topic
         self.callback = callback
         self.callback_group = callback_group
@@ -159,6 +164,10 @@ class Subscription:
         if publisher_name in self._warned_publishers:
             return
         self._warned_publishers.add(publisher_name)
+        self._incompatible_qos.report(policy_kind)
+
+    def _default_incompatible_qos(self, policy_kind: int) -> None:
+        """rclpy's default callback for the event (rclpy/event_handler.py)."""
         self._node.get_logger().warning(
             f"New publisher discovered on topic '{self.topic_name}', offering incompatible QoS. "
             "No messages will be received from it. Last incompatible policy: "
