@@ -229,11 +229,6 @@ def test_a_cancel_the_server_accepts_ends_the_goal_canceled(launcher, tmp_path: 
     assert len(feedback_lines(client)) <= 3
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="rclpy in the sandbox: a callback sleeping (time.sleep) under a MultiThreadedExecutor "
-    "runs no other callback meanwhile, where rclpy's other threads would take the cancel request",
-)
 def test_a_sleeping_execute_callback_takes_a_cancel_under_a_multi_threaded_executor(
     launcher, tmp_path: Path
 ) -> None:

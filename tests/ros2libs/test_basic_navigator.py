@@ -98,10 +98,6 @@ while not navigator.isTaskComplete():
 navigator.get_logger().info(f"second {navigator.getResult()}")
 navigator.lifecycleShutdown()
 try:
-    navigator.goThroughPoses([pose(1.0, 0.0)])
-except RuntimeError as error:
-    navigator.get_logger().info(f"through poses: {error}")
-try:
     navigator.clearAllCostmaps()
 except AttributeError as error:
     navigator.get_logger().info(f"costmaps: {error}")
@@ -125,7 +121,6 @@ def test_a_goal_to_success_and_one_canceled(launcher, tmp_path: Path) -> None:
     assert remaining[0] >= 0.9 and remaining[-1] <= 0.2
     assert "second TaskResult.CANCELED" in commander
     assert "costmaps: BasicNavigator.clearAllCostmaps() is not available" in commander
-    assert "through poses: BasicNavigator.goThroughPoses() needs the " in commander
 
 
 WAYPOINTS = """
@@ -158,6 +153,13 @@ while not navigator.isTaskComplete():
     if feedback is not None:
         reached.add(feedback.current_waypoint)
 navigator.get_logger().info(f"waypoints {navigator.getResult()} feedback {sorted(reached)}")
+navigator.goThroughPoses([pose(2.2, 1.6), pose(2.0, 1.4)])
+remaining = set()
+while not navigator.isTaskComplete():
+    feedback = navigator.getFeedback()
+    if feedback is not None:
+        remaining.add(feedback.number_of_poses_remaining)
+navigator.get_logger().info(f"through poses {navigator.getResult()} remaining {sorted(remaining)}")
 rclpy.shutdown()
 """
 
@@ -170,7 +172,7 @@ def test_waypoints_and_a_path_from_the_runs_navigation(launcher, tmp_path: Path)
         robot="turtlebot3",
         world="office",
         spawn="start",
-        duration_s=30.0,
+        duration_s=45.0,
         builtin_nodes=("map_server", "localization", "nav2"),
     )
     log = outcome.log("waypoints")
@@ -180,4 +182,7 @@ def test_waypoints_and_a_path_from_the_runs_navigation(launcher, tmp_path: Path)
     assert count >= 2 and math.hypot(x1 - 2.5, y1 - 2.0) < 0.1
     assert math.hypot(x0 - 2.0, y0 - 1.3) < 0.3  # planned from where the robot is
     assert "waypoints TaskResult.SUCCEEDED feedback [0, 1]" in log
-    assert math.hypot(outcome.end.x - 2.5, outcome.end.y - 2.0) < 0.25, outcome.end
+    through = re.search(r"through poses TaskResult.SUCCEEDED remaining \[([0-9, ]+)\]", log)
+    assert through, log  # the feedback counted the poses still ahead
+    assert {int(n) for n in through.group(1).split(",")} <= {0, 1, 2}
+    assert math.hypot(outcome.end.x - 2.0, outcome.end.y - 1.4) < 0.25, outcome.end
