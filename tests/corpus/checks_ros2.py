@@ -129,7 +129,12 @@ def check_qos_mismatch(outcome: Outcome) -> None:
     assert reliable == 0, counts  # a RELIABLE request is not met by a BEST_EFFORT offer
     assert best_effort >= at_least(outcome, 20, 1.5), counts
     # rclpy's warning on the subscriber's side names the policy.
-    assert_log(outcome, node, r"incompatible QoS.*\n?.*RELIABILITY")
+    assert_log(
+        outcome,
+        node,
+        r"New publisher discovered on topic '/range_m', offering incompatible QoS\..*"
+        r"Last incompatible policy: RELIABILITY",
+    )
     relayed = outcome.messages("range_m")
     assert len(relayed) >= at_least(outcome, 20, 2.5), len(relayed)
     assert relayed[0][1].data == pytest.approx(0.60, abs=0.02)
@@ -147,6 +152,8 @@ def check_latched(outcome: Outcome) -> None:
 
 
 def check_map_listener(outcome: Outcome) -> None:
+    # map_server offers `map` TRANSIENT_LOCAL and RELIABLE, as Nav2's does: a match, no warning.
+    assert "incompatible QoS" not in outcome.log("map_listener"), outcome.log("map_listener")
     match = assert_log(
         outcome,
         "map_listener",
@@ -342,7 +349,8 @@ def check_nav2_goto_pose(outcome: Outcome) -> None:
     assert_log(outcome, "nav2_goto_pose", r"Goal succeeded!")
     assert logged(outcome, "nav2_goto_pose", r"Distance remaining: (\d+\.\d+) m")
     end = outcome.end
-    assert math.hypot(end.x - 2.5, end.y - 2.0) < 0.25, end  # Nav2's default xy tolerance
+    # Nav2's goal checker stops within 0.25 m of the goal by the localization's estimate.
+    assert math.hypot(end.x - 2.5, end.y - 2.0) < 0.3, end
     assert outcome.metrics["run"]["collisions"] == 0
     assert outcome.reason == "finished: every node ended"
 
