@@ -162,6 +162,11 @@ class RunSpec:
                 raise RunSpecError(
                     f"unknown built-in node '{name}'; built-in nodes: {', '.join(BUILTIN_NODES)}"
                 )
+            if BUILTIN_NODES[name].ros2_native and self.ros_version != 2:
+                raise RunSpecError(
+                    f"built-in node '{name}' serves ROS 2 nodes (rclpy) only, and this run's "
+                    "nodes are ROS 1; write them with rclpy or leave the built-in out"
+                )
         for time_s, action, _ in self.script:
             if not (isinstance(time_s, (int, float)) and 0 <= time_s <= self.duration_s):
                 raise RunSpecError(f"scripted '{action}' at {time_s!r} s is outside the run")

@@ -88,3 +88,14 @@ def test_an_explicit_run_version_overrides_and_is_checked_against_the_nodes():
     assert str(caught.value) == (
         "node `a` uses rclpy (ROS 2) but this run is ROS 1; a run is one or the other"
     )
+
+
+def test_a_ros2_only_built_in_in_a_ros1_run_is_refused_with_a_sentence():
+    spec(node("a", RCLPY), builtin_nodes=("map_server", "nav2")).validate()  # ROS 2: fine
+    spec(node("a", ROSPY), builtin_nodes=("map_server",)).validate()
+    with pytest.raises(RunSpecError) as caught:
+        spec(node("a", ROSPY), builtin_nodes=("map_server", "nav2")).validate()
+    assert str(caught.value) == (
+        "built-in node 'nav2' serves ROS 2 nodes (rclpy) only, and this run's nodes are ROS 1; "
+        "write them with rclpy or leave the built-in out"
+    )
