@@ -226,6 +226,7 @@ def test_unknown_axes_get_a_sentence() -> None:
 
 
 def test_star_import_gives_the_public_functions() -> None:
+    install_ros_compat()  # a ROS 2 node run in this process before switched the layers over
     namespace: dict[str, object] = {}
     exec("from tf.transformations import *", namespace)
     for name in ("euler_from_quaternion", "quaternion_from_euler", "quaternion_multiply",
