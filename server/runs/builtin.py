@@ -54,6 +54,9 @@ class BuiltinNode:
     name = "builtin"
     subscribes: tuple[str, ...] = ()
     publishes: tuple[tuple[str, str], ...] = ()  # (topic, ROS type), told to student nodes
+    # Topics of `publishes` whose last message reaches later subscribers too: map_server's map
+    # is latched in ROS 1 and TRANSIENT_LOCAL in Nav2's map_server (ROS 2).
+    latched: tuple[str, ...] = ()
     rate_hz: float | None = None
     # False: the node publishes and receives ROS 1 objects (sandbox.msgs) and the host converts
     # them in a ROS 2 run. True: it speaks ROS 2 (sandbox.msgs2 objects, ROS 2 type names in
@@ -83,6 +86,7 @@ class BuiltinNode:
 class MapServer(BuiltinNode):
     name = "map_server"
     publishes = (("map", "nav_msgs/OccupancyGrid"),)
+    latched = ("map",)
 
     def start(self, run: Run) -> list[tuple[str, object]]:
         grid = run.sim.world.grid_map

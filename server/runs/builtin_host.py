@@ -57,6 +57,11 @@ class BuiltinHost:
             run.bus.add_node(node.name)
             for topic, kind in node.graph_subscriptions():
                 run.bus.declare_listener(node.name, topic, kind)
+            for topic, kind in node.publishes:
+                if topic in node.latched:
+                    name = kind if node.ros2_native else run.dialect.type_name(kind)
+                    run.bus.declare_topic(topic, name, node.name)
+                    run.bus.topics[topic].latched_by.add(node.name)
         # Every built-in is ready before any publishes (the planner needs its map before the
         # waypoints node sends the first goal).
         started = [(node, node.start(run)) for node in self.nodes]

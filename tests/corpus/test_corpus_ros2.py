@@ -143,8 +143,6 @@ CASES = (
         nodes=(Node("map_listener.py"),),
         spawn="start",
         builtin_nodes=("map_server",),
-        # /work/agents/corpus2-findings.md item 1: the map arrives, but with a DURABILITY warning
-        needs=("the built-in map_server's latched map offered TRANSIENT_LOCAL to rclpy",),
     ),
     ros2_case(
         "fibonacci_action",
