@@ -18,7 +18,7 @@ from sandbox.protocol import Envelope, TopicDecl
 from server.runs.builtin import BUILTIN_NODES, BuiltinNode
 from server.runs.faults import FaultKind
 from server.runs.run import Run
-from server.runs.spec import NodeSpec, RunSpec
+from server.runs.spec import NodeSpec, RunSpec, RunSpecError
 
 NS = 1_000_000_000
 
@@ -269,7 +269,7 @@ def test_a_ros2_native_builtin_is_a_graph_subscriber_and_speaks_ros2(tmp_path, m
     assert {"/echoed", "/__srv__/echo"} <= recorded
 
 
-def test_a_ros2_native_builtin_is_left_out_of_a_ros1_run(tmp_path, monkeypatch):
+def test_a_ros2_native_builtin_in_a_ros1_run_is_refused(tmp_path, monkeypatch):
     monkeypatch.setitem(BUILTIN_NODES, "echo_service", EchoService)
     spec = RunSpec(
         robot="crowbot",
@@ -277,8 +277,8 @@ def test_a_ros2_native_builtin_is_left_out_of_a_ros1_run(tmp_path, monkeypatch):
         nodes=(NodeSpec("driver", "import rospy\n", "driver.py"),),
         builtin_nodes=("echo_service",),
     )
-    run = Run(spec, launcher=None, out_dir=tmp_path)
-    assert run.builtins.get("echo_service") is None
+    with pytest.raises(RunSpecError, match="'echo_service' serves ROS 2 nodes"):
+        Run(spec, launcher=None, out_dir=tmp_path)
 
 
 class ForgetfulNative(BuiltinNode):
