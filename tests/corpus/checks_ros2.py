@@ -355,6 +355,24 @@ def check_nav2_goto_pose(outcome: Outcome) -> None:
     assert outcome.reason == "finished: every node ended"
 
 
+def check_ament_package_launch(outcome: Outcome) -> None:
+    # Parameters: speed from the YAML's /** section, turn_speed from its `patrol` section,
+    # leg_length:=0.3 from the command line over the launch argument's default 0.4.
+    assert_log(outcome, "patrol", r"patrol: legs of 0\.30 m at 0\.12 m/s, use_sim_time=True")
+    assert_log(outcome, "patrol", r"leg out done at x=0\.3\d y=-?0\.0\d")
+    assert_log(outcome, "patrol", r"turned around")
+    assert_log(outcome, "patrol", r"leg back done")
+    start, end = outcome.start, outcome.end
+    assert math.hypot(end.x - start.x, end.y - start.y) < 0.1, (start, end)
+    assert angle_between(end.yaw, start.yaw + math.pi) == pytest.approx(0.0, abs=0.15)
+    farthest = max(pose.x for pose in outcome.poses) - start.x
+    assert farthest == pytest.approx(0.30, abs=0.05)
+    # The logger's wheel_odom is remapped to the robot's odom; it logs once a second.
+    lines = logged(outcome, "odom_logger", r"tb3 odom: x=(-?\d\.\d\d) y=-?\d\.\d\d")
+    assert len(lines) >= at_least(outcome, 1, 7.0), lines
+    assert publishers(outcome, "cmd_vel") == ["patrol"]
+
+
 def check_launch(outcome: Outcome, stop_distance_m: float = 0.30) -> None:
     assert_log(
         outcome,

@@ -308,6 +308,16 @@ CASES = (
         launch_args=("stop_distance:=0.45",),
         clocks=(Clock.LOCKSTEP,),  # the launch file's realtime run is launch_file's
     ),
+    ros2_case(
+        "ament_package_launch",
+        "turtlebot3",
+        "office",
+        9.0,
+        checks.check_ament_package_launch,
+        launch="patrol_pkg/launch/patrol.launch.py",
+        launch_args=("leg_length:=0.3",),
+        spawn="corridor",
+    ),
 )
 
 
@@ -424,7 +434,9 @@ def test_the_ros2_corpus_is_large_enough_and_every_script_is_used() -> None:
     launched = {"launch_driver.py", "range_monitor.py"}  # named by launch/approach.launch.py
     assert len(scripts) >= 24
     assert scripts == used | launched, scripts ^ (used | launched)
-    for path in [*SCRIPTS_ROS2.glob("*.py"), *SCRIPTS_ROS2.glob("launch/*.py")]:
+    for path in SCRIPTS_ROS2.rglob("*.py"):
+        if path.name == "__init__.py":
+            continue
         lines = path.read_text().splitlines()
         comment = lines[1] if lines[0].startswith("#!") else lines[0]
         assert comment.startswith("# Course pattern: "), path.name
