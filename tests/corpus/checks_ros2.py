@@ -373,7 +373,8 @@ def check_ament_package_launch(outcome: Outcome) -> None:
     assert publishers(outcome, "cmd_vel") == ["patrol"]
 
 
-def check_launch(outcome: Outcome, stop_distance_m: float = 0.30) -> None:
+def check_launch(outcome: Outcome) -> None:
+    stop_distance_m = 0.30  # the launch argument's default
     assert_log(
         outcome,
         "driver",
@@ -391,7 +392,3 @@ def check_launch(outcome: Outcome, stop_distance_m: float = 0.30) -> None:
     assert too_close and not too_close[0], too_close[:3]
     # The monitor's threshold is 40 cm: it turns true once the robot is that close.
     assert too_close[-1] is (stop_distance_m < 0.40), too_close[-3:]
-
-
-def check_launch_with_args(outcome: Outcome) -> None:
-    check_launch(outcome, stop_distance_m=0.45)

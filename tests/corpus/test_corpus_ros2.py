@@ -299,23 +299,13 @@ CASES = (
         launch="launch/approach.launch.py",
     ),
     ros2_case(
-        "launch_file_args",
-        "crowbot",
-        "wall_approach",
-        6.0,
-        checks.check_launch_with_args,
-        launch="launch/approach.launch.py",
-        launch_args=("stop_distance:=0.45",),
-        clocks=(Clock.LOCKSTEP,),  # the launch file's realtime run is launch_file's
-    ),
-    ros2_case(
         "ament_package_launch",
         "turtlebot3",
         "office",
         9.0,
         checks.check_ament_package_launch,
         launch="patrol_pkg/launch/patrol.launch.py",
-        launch_args=("leg_length:=0.3",),
+        launch_args=("leg_length:=0.3",),  # a launch argument from the command line
         spawn="corridor",
     ),
 )
