@@ -306,3 +306,31 @@ node.create_publisher(String, 'order', 10).publish(String(data=''.join(order)))
     yields, exited, _ = run(code, tmp_path, sensors, name="fair")
     assert exited.outcome is Outcome.FINISHED, exited.error
     assert [m.data for m in published(yields, exited, "order")] == ["dbdb"]
+
+
+def test_a_timer_of_period_zero_is_a_busy_loop_that_lets_time_pass(tmp_path: Path) -> None:
+    code = """
+import rclpy
+from rclpy.node import Node
+from std_msgs.msg import Int64
+
+rclpy.init()
+node = Node('busy')
+calls = [0]
+
+def tick():
+    calls[0] += 1
+    if node.get_clock().now().nanoseconds >= 50_000_000:
+        out = node.create_publisher(Int64, 'calls', 10)
+        out.publish(Int64(data=calls[0]))
+        rclpy.shutdown()
+
+node.create_timer(0.0, tick)
+rclpy.spin(node)
+"""
+    yields, exited, _ = run(code, tmp_path, name="busy")
+    assert exited.outcome is Outcome.FINISHED, exited.error
+    (calls,) = [m.data for m in published(yields, exited, "calls")]
+    # Each call polls twice (the executor's turn and clock.now()); 100 free polls per wake,
+    # then 20 us each with a wake every 5 ms: 50 ms of simulated time is about 1750 calls.
+    assert 1500 < calls < 2000, calls

@@ -189,6 +189,9 @@ class Executor:
             work = self._next_work()
             if work is not None:
                 self._execute(work)
+                # An executor that always has work (a timer of period 0) is a busy loop: past
+                # the free polls its callbacks cost time, so a lockstep run moves on.
+                self._poll()
                 return
             if condition():
                 return
