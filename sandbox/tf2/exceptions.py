@@ -1,5 +1,7 @@
 """tf2's exceptions (the names and hierarchy of tf2_py, which tf2_ros re-exports): every one is
-a TransformException, so `except tf2_ros.TransformException:` catches them all."""
+a TransformException, so `except tf2_ros.TransformException:` catches them all. They are
+defined in tf2_py's C module `tf2` in both ROS 1 and ROS 2, so a traceback names them
+`tf2.LookupException`; `__module__` says the same here instead of our internal path."""
 
 from __future__ import annotations
 
@@ -26,3 +28,14 @@ class InvalidArgumentException(TransformException):
 
 class TimeoutException(TransformException):
     """A wait for a transform ran out of time."""
+
+
+for _exception in (
+    TransformException,
+    ConnectivityException,
+    LookupException,
+    ExtrapolationException,
+    InvalidArgumentException,
+    TimeoutException,
+):
+    _exception.__module__ = "tf2"

@@ -111,3 +111,15 @@ def test_geometry_transforms_take_ros2_messages() -> None:
     assert (bare.position.x, bare.orientation.z) == pytest.approx((2.0, math.sqrt(0.5)))
     with pytest.raises(TypeError, match="TransformStamped"):
         geometry.do_transform_point(point, pose)
+
+
+def test_a_traceback_names_tf2s_exceptions_as_tf2_does():
+    # tf2_py defines them in its C module `tf2`: students see `tf2.LookupException`, not ours.
+    import traceback
+
+    try:
+        raise LookupException('"base_foot" passed to lookupTransform does not exist')
+    except LookupException as error:
+        line = traceback.format_exception_only(error)[-1]
+    assert line.startswith("tf2.LookupException: "), line
+    assert ExtrapolationException.__module__ == "tf2"
