@@ -141,7 +141,10 @@ def check_timer(outcome: Outcome) -> None:
     if outcome.clock is Clock.LOCKSTEP:
         assert period == pytest.approx(0.1, abs=0.001)
     else:
-        assert 0.09 <= period <= 0.3
+        # rospy.Timer keeps a fixed schedule: after a tick a loaded machine woke late, the next
+        # period is that much shorter (0.077 s seen after a 23 ms late tick), so only the
+        # order of magnitude is checked here; the tick count above checks the rate.
+        assert 0.05 <= period <= 0.3, period
 
 
 def check_services(outcome: Outcome) -> None:
