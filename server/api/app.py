@@ -18,6 +18,7 @@ from fastapi.staticfiles import StaticFiles
 
 from sandbox.launcher import Launcher
 from server.api import errors
+from server.api.auth import CsrfGuard
 from server.api.routes import (
     admin,
     admin_courses,
@@ -33,6 +34,7 @@ from server.api.routes import (
     workspaces,
 )
 from server.api.settings import Settings
+from server.api.sockets import OpenSockets
 from server.service.hardware import HardwareHub
 from server.service.runs import RunService
 from server.store import accounts
@@ -102,9 +104,11 @@ def create_app(settings: Settings | None = None, launcher: Launcher | None = Non
         lifespan=lifespan,
     )
     app.state.settings = settings
+    app.state.sockets = OpenSockets()  # open websockets by user: disabling a user closes them
     errors.install(app)
     # The student page's bundle is ~500 KiB, ~180 KiB gzipped: it matters on a classroom link.
     app.add_middleware(GZipMiddleware, minimum_size=1024)
+    app.add_middleware(CsrfGuard)  # cookie-authenticated state changes from our own origin only
 
     @app.middleware("http")
     async def limit_body(request: Request, call_next):

@@ -46,9 +46,13 @@ class RunControls:
     def pause(self) -> None:
         if self.spec.clock is not Clock.LOCKSTEP:
             raise ValueError("only a lockstep (simulated-time) run can pause; stop it instead")
+        if self.state is RunState.PAUSED:
+            raise ValueError("the run is already paused; resume it to go on")
         self._control(("pause", None))
 
     def resume(self) -> None:
+        if self.state is not RunState.PAUSED:
+            raise ValueError(f"the run is not paused (it is {self.state}); nothing to resume")
         self._control(("resume", None))
 
     def press_button(self, pressed: bool) -> None:

@@ -101,7 +101,9 @@ class LabServer:
     def student(self, name: str = "student") -> httpx.Client:
         """A logged-in browser-like client: opened the invite link, holds the cookie."""
         user, token = self.new_user(name)
+        # A real browser sends its page's Origin with every POST; the CSRF guard checks it.
         client = self.client()
+        client.headers["Origin"] = self.url
         answer = client.get(f"/login?token={token}", follow_redirects=False)
         assert answer.status_code == 303, answer.text
         client.user = user  # type: ignore[attr-defined]

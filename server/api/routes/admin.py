@@ -134,6 +134,7 @@ def update_user(
             accounts.set_disabled(db, user, body.disabled)
         out = user_out(user, request)
     if body.disabled:
+        request.app.state.sockets.revoke(user_id)  # live views and 3D views close now
         out["runs_stopped"] = request.app.state.runs.stop_user(user_id, "the user was disabled")
     return out
 

@@ -18,7 +18,9 @@ Client -> server commands, each answered with an ack or an error carrying its "i
 
 Latest wins: a slow client gets the newest sample at its rate and a count of what it missed;
 nothing queues per client beyond one frame in flight. Someone else's run: closed with code
-4404, as if it did not exist; no login: 4401.
+4404, as if it did not exist; no login: 4401. A handshake from another site's page (its Origin
+is not the lab's) is refused before accept (HTTP 403); a user disabled while watching is closed
+with 1008.
 """
 
 from __future__ import annotations
@@ -26,17 +28,20 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import json
+import logging
 import math
 import time
 
 from fastapi import APIRouter, WebSocket, WebSocketDisconnect
 from starlette.concurrency import run_in_threadpool
 
-from server.api.auth import websocket_user
+from server.api.auth import foreign_origin, websocket_user
+from server.api.sockets import REVOKED_CODE, REVOKED_REASON
 from server.service.telemetry import SubscriptionError, UnknownRunError, ViewerLimitError
 from server.store import runs as run_store
 
 router = APIRouter()
+log = logging.getLogger("robodojo.api")
 NOT_FOUND_CODE = 4404  # websocket close code: no such run, or not yours
 NOT_LOGGED_IN_CODE = 4401  # websocket close code: no session cookie or token (as the 3D view)
 COMMANDS_PER_S = 50  # a person clicking and typing; more is a runaway client
@@ -102,6 +107,12 @@ def _apply(op: str, command: dict, viewer, active) -> None:
 @router.websocket("/api/runs/{run_id}/live")
 async def live(websocket: WebSocket, run_id: str) -> None:
     app = websocket.app
+    origin = foreign_origin(websocket.scope)
+    if origin is not None:
+        log.warning("run %s: live view refused: its page is at %s, not the lab's origin",
+                    run_id[:64], origin)  # fmt: skip
+        await websocket.close(code=1008)  # before accept: the handshake is answered 403
+        return
     caller = await run_in_threadpool(websocket_user, websocket)
     record = None
     if caller is not None and len(run_id) <= 64:
@@ -185,19 +196,24 @@ async def live(websocket: WebSocket, run_id: str) -> None:
         final = telemetry.snapshot()
         await send({"type": "end", "state": final["state"], "reason": final["reason"]})
 
-    tasks = [asyncio.create_task(reader()), asyncio.create_task(writer())]
-    try:
-        done, _ = await asyncio.wait(tasks, return_when=asyncio.FIRST_COMPLETED)
-        for task in done:
-            error = task.exception()
-            if error is not None and not isinstance(error, WebSocketDisconnect | RuntimeError):
-                raise error
-    finally:
-        for task in tasks:
-            task.cancel()
-        for task in tasks:
-            with contextlib.suppress(BaseException):
-                await task
-        viewer.close()
-        with contextlib.suppress(Exception):
-            await websocket.close()
+    close_code, close_reason = 1000, ""
+    async with app.state.sockets.held(caller.id) as revoked:
+        tasks = [asyncio.create_task(reader()), asyncio.create_task(writer())]
+        disabled = asyncio.create_task(revoked.wait())
+        try:
+            done, _ = await asyncio.wait([*tasks, disabled], return_when=asyncio.FIRST_COMPLETED)
+            if disabled in done:
+                close_code, close_reason = REVOKED_CODE, REVOKED_REASON
+            for task in done - {disabled}:
+                error = task.exception()
+                if error is not None and not isinstance(error, WebSocketDisconnect | RuntimeError):
+                    raise error
+        finally:
+            for task in (*tasks, disabled):
+                task.cancel()
+            for task in (*tasks, disabled):
+                with contextlib.suppress(BaseException):
+                    await task
+            viewer.close()
+            with contextlib.suppress(Exception):
+                await websocket.close(code=close_code, reason=close_reason)

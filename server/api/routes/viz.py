@@ -22,8 +22,8 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import http.client
+import logging
 from contextlib import asynccontextmanager
-from urllib.parse import urlsplit
 
 from fastapi import APIRouter, Depends, Request, WebSocket
 from fastapi.responses import RedirectResponse, Response
@@ -31,11 +31,13 @@ from starlette.concurrency import run_in_threadpool
 from websockets.asyncio.client import connect
 from websockets.exceptions import ConnectionClosed, InvalidHandshake
 
-from server.api.auth import Caller, current_user, websocket_user
+from server.api.auth import Caller, current_user, foreign_origin, websocket_user
 from server.api.routes.runs import NOT_FOUND, visible_run
+from server.api.sockets import REVOKED_CODE, REVOKED_REASON
 from server.store import runs as run_store
 from server.viz.manager import LOOPBACK, VizManager
 
+log = logging.getLogger("robodojo.api")
 NOT_LOGGED_IN_CODE = 4401  # websocket close code: no session cookie or token
 NOT_FOUND_CODE = 4404  # websocket close code: no such run, or not yours
 UPSTREAM_TIMEOUT_S = 10.0  # [s] to reach the run's viser server on loopback
@@ -105,24 +107,12 @@ async def view_page(
     return Response(body, status_code=status, headers=kept)
 
 
-def _same_origin(websocket: WebSocket) -> bool:
-    """True without an Origin header (not a browser) or when it names the host asked for."""
-    origin = websocket.headers.get("origin")
-    if origin is None:
-        return True
-    host = websocket.headers.get("host", "")
-    allowed = {host}
-    public_url = getattr(websocket.app.state.settings, "public_url", None)
-    if public_url:
-        allowed.add(urlsplit(public_url).netloc)
-    return urlsplit(origin).netloc in allowed
-
-
 async def _visible_record(websocket: WebSocket, run_id: str):
-    """(record, None) for a caller who may see the run, else (None, (close code, reason))."""
+    """(record, caller, None) for a caller who may see the run, else (None, None, (close code,
+    reason))."""
     caller = await run_in_threadpool(websocket_user, websocket)
     if caller is None:
-        return None, (NOT_LOGGED_IN_CODE, "not logged in")
+        return None, None, (NOT_LOGGED_IN_CODE, "not logged in")
     record = None
     if len(run_id) <= 64 and "\x00" not in run_id:
 
@@ -132,16 +122,19 @@ async def _visible_record(websocket: WebSocket, run_id: str):
 
         record = await run_in_threadpool(lookup)
     if record is None or not caller.can_see(record.user_id):
-        return None, (NOT_FOUND_CODE, NOT_FOUND)
-    return record, None
+        return None, None, (NOT_FOUND_CODE, NOT_FOUND)
+    return record, caller, None
 
 
 @router.websocket("/api/runs/{run_id}/viz")
 async def view_socket(websocket: WebSocket, run_id: str) -> None:
-    if not _same_origin(websocket):
+    origin = foreign_origin(websocket.scope)
+    if origin is not None:
+        log.warning("run %s: 3D view refused: its page is at %s, not the lab's origin",
+                    run_id[:64], origin)  # fmt: skip
         await websocket.close(code=1008)  # before accept: the handshake is answered 403
         return
-    record, refusal = await _visible_record(websocket, run_id)
+    record, caller, refusal = await _visible_record(websocket, run_id)
     if refusal is not None:
         await websocket.accept()
         await websocket.close(code=refusal[0], reason=refusal[1])
@@ -165,11 +158,13 @@ async def view_socket(websocket: WebSocket, run_id: str) -> None:
             return
         async with upstream:
             await websocket.accept(subprotocol=upstream.subprotocol)
-            await _pump(websocket, upstream)
+            async with websocket.app.state.sockets.held(caller.id) as revoked:
+                await _pump(websocket, upstream, revoked)
 
 
-async def _pump(websocket: WebSocket, upstream) -> None:
-    """Forward both ways until either side closes; then close the other with the same code."""
+async def _pump(websocket: WebSocket, upstream, revoked: asyncio.Event) -> None:
+    """Forward both ways until either side closes; then close the other with the same code.
+    `revoked` set (the user was disabled): both close, the browser with 1008."""
 
     async def browser_to_viser() -> tuple[int, str]:
         while True:
@@ -190,16 +185,19 @@ async def _pump(websocket: WebSocket, upstream) -> None:
 
     to_viser = asyncio.create_task(browser_to_viser())
     to_browser = asyncio.create_task(viser_to_browser())
+    disabled = asyncio.create_task(revoked.wait())
     try:
-        await asyncio.wait((to_viser, to_browser), return_when=asyncio.FIRST_COMPLETED)
+        await asyncio.wait((to_viser, to_browser, disabled), return_when=asyncio.FIRST_COMPLETED)
     finally:
-        for task in (to_viser, to_browser):
+        for task in (to_viser, to_browser, disabled):
             task.cancel()
-        for task in (to_viser, to_browser):
+        for task in (to_viser, to_browser, disabled):
             with contextlib.suppress(BaseException):
                 await task
     code, reason = 1000, ""
-    if to_browser.done() and not to_browser.cancelled() and to_browser.exception() is None:
+    if revoked.is_set():
+        code, reason = REVOKED_CODE, REVOKED_REASON
+    elif to_browser.done() and not to_browser.cancelled() and to_browser.exception() is None:
         code, reason = to_browser.result()  # viser closed: the browser hears why
     with contextlib.suppress(Exception):
         await upstream.close()
