@@ -17,7 +17,8 @@ from server.api.settings import Settings
 
 def _settings(args: argparse.Namespace) -> Settings:
     overrides = {}
-    for key in ("host", "port", "data", "database_url", "public_url", "rosserial_port"):
+    keys = ("host", "port", "data", "database_url", "public_url")
+    for key in (*keys, "rosserial_port", "rosserial_host"):
         value = getattr(args, key, None)
         if value is not None:
             overrides[key] = value
@@ -98,6 +99,12 @@ def add_commands(commands) -> None:
         type=int,
         default=None,
         help="TCP port real CrowBots connect to (default 11411; 0 any free port; -1 off)",
+    )
+    serve.add_argument(
+        "--rosserial-host",
+        default=None,
+        help="address the rosserial port listens on: the robots' VLAN/SSID interface (default: "
+        "--host); ros_lib has no authentication, see README 'Network isolation for the bench'",
     )
     serve.add_argument(
         "--unsafe-no-sandbox",

@@ -6,9 +6,14 @@ matched to their inventory entries, each with a fair queue, handed to runs as a 
     hub.queue("crowbot-1").join(user_id, now)            # server/hardware/queue.py
 
 A robot is matched by the address it connects from (its inventory entry's `address`, the
-CrowBot's WiFi IP) and must offer the topics of its kind (the simulated robot's names and
-types); a mismatch is kept as a problem the instructor sees. The rosserial thread hands each
-message to the link's inbox (bounded: latest values win when a run is not reading).
+CrowBot's WiFi IP): ros_lib has no authentication, so an address no entry has gets no session
+(closed at accept, see server/hardware/rosserial/admission.py), and a second connection for a
+robot that is in a run is refused so it cannot end that run or feed it readings (the instructor
+sees the conflict in the robot's connection state); an idle robot's reconnection replaces its
+old session (a rebooted robot comes back). A robot must offer the topics of its kind (the
+simulated robot's names and types); a mismatch is kept as a problem the instructor sees. The
+rosserial thread hands each message to the link's inbox (bounded: latest values win when a run
+is not reading).
 """
 
 from __future__ import annotations
@@ -19,8 +24,8 @@ import threading
 import time
 from collections import deque
 
-from server.hardware.queue import RobotQueue
-from server.hardware.rosserial import RobotConnection, RosserialHandler, RosserialServer
+from server.hardware.queue import RobotQueue, SlotState
+from server.hardware.rosserial import Refusal, RobotConnection, RosserialHandler, RosserialServer
 from server.hardware.rosserial.messages import LogLevel
 from server.sim.registry import get_robot
 from server.store import robots as inventory
@@ -97,6 +102,7 @@ class HardwareHub(RosserialHandler):
         self._links: dict[str, RosserialLink] = {}
         self._by_connection: dict[str, str] = {}  # connection id -> robot name
         self._problems: dict[str, list[str]] = {}  # robot name or address -> sentences
+        self._conflicts: dict[str, str] = {}  # robot name -> the last refused second connection
         self._queues: dict[str, RobotQueue] = {}
         self._lock = threading.Lock()
         self.server: RosserialServer | None = None
@@ -112,7 +118,8 @@ class HardwareHub(RosserialHandler):
         if port is None or port < 0:
             self.listen_error = "rosserial is switched off (--rosserial-port -1)"
             return
-        server = RosserialServer(self, host=self.settings.rosserial_host, port=port)
+        host = self.settings.rosserial_bind_host
+        server = RosserialServer(self, host=host, port=port)
         try:
             server.start()
         except OSError as error:  # a busy port must not stop the lab: simulation goes on
@@ -120,7 +127,13 @@ class HardwareHub(RosserialHandler):
             log.warning("%s", self.listen_error)
             return
         self.server = server
-        log.info("rosserial: CrowBots connect to port %d", server.port)
+        log.info("rosserial: CrowBots connect to %s:%d", host, server.port)
+        if host in ("127.0.0.1", "::1", "localhost"):
+            log.warning(
+                "rosserial listens on %s only: robots on the network cannot connect; pass "
+                "--rosserial-host with the address of the robots' VLAN/SSID interface",
+                host,
+            )
 
     def _tick_queues(self) -> None:
         while not self._closing.wait(QUEUE_TICK_S):
@@ -148,6 +161,38 @@ class HardwareHub(RosserialHandler):
         return self.server.port if self.server is not None else None
 
     # ------------------------------------------------------------------ rosserial thread
+    def admit(self, host: str) -> Refusal | None:
+        with self.store.session() as db:
+            entry = inventory.by_address(db, "rosserial", host)
+            name = entry.name if entry is not None else None
+        if name is None:
+            return Refusal(
+                f"{host} is no registered robot's address: register it (POST /api/admin/robots "
+                "with this address) if it is one of the bench's robots"
+            )
+        return self._refuse_if_in_run(name, host)
+
+    def _in_run(self, name: str) -> bool:
+        with self._lock:
+            queue = self._queues.get(name)
+            link = self._links.get(name)
+        running = queue is not None and any(p.state is SlotState.RUNNING for p in queue.places)
+        return running and link is not None and link.connected
+
+    def _refuse_if_in_run(self, name: str, host: str) -> Refusal | None:
+        """A robot in a run keeps its session: a newcomer from its address would end the run
+        and, if it is not the robot, feed the next run its readings."""
+        if not self._in_run(name):
+            return None
+        sentence = (
+            f"a second connection from {host} was refused while {name} is in a run "
+            f"(at {time.strftime('%H:%M:%S')}); if the robot rebooted, it is admitted once "
+            "the run ends or its old connection times out"
+        )
+        with self._lock:
+            self._conflicts[name] = sentence
+        return Refusal(sentence, backoff=False)
+
     def on_robot_connected(self, robot: RobotConnection) -> None:
         address = robot.peer[0]
         with self.store.session() as db:
@@ -168,8 +213,13 @@ class HardwareHub(RosserialHandler):
                         f"{name} does not offer topic '{topic.name}' [{topic.type_name}] that a "
                         f"{kind} has (it offers: {', '.join(sorted(offered)) or 'nothing'})"
                     )
+        if known and (refusal := self._refuse_if_in_run(name, address)) is not None:
+            log.warning("hardware: %s", refusal.reason)  # it was admitted before the run began
+            robot.stop()
+            return
         with self._lock:
             self._problems[name] = problems
+            self._conflicts.pop(name, None)
             if known:
                 old = self._links.get(name)
                 if old is not None:
@@ -254,8 +304,11 @@ class HardwareHub(RosserialHandler):
     def connection_state(self, name: str) -> str:
         with self._lock:
             link = self._links.get(name)
+            conflict = self._conflicts.get(name)
         if link is not None and link.connected:
-            problems = self._problems.get(name) or []
+            problems = list(self._problems.get(name) or [])
+            if conflict:
+                problems.append(conflict)
             return (
                 "connected" if not problems else "connected with problems: " + "; ".join(problems)
             )

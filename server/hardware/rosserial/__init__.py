@@ -4,11 +4,13 @@
 - ``session``: one connection's protocol state machine (pure, sans-IO); ``events``: what it
   reports.
 - ``server``: the TCP server, one session per robot, callbacks to the rest of RoboDojo.
+- ``admission``: who gets a session (ros_lib has no authentication), back-off of refused peers.
 - ``limits``: every limit in one table. ``messages``: rosserial_msgs TopicInfo and Log.
 
 Protocol facts and their sources are in each module's docstring and shared/notes/protocols.md.
 """
 
+from server.hardware.rosserial.admission import Refusal
 from server.hardware.rosserial.events import Direction, RobotTopic
 from server.hardware.rosserial.frames import DropReason, Frame, FrameParser, TopicId, encode_frame
 from server.hardware.rosserial.limits import DEFAULT_LIMITS, RosserialLimits
@@ -35,6 +37,7 @@ __all__ = [
     "Frame",
     "FrameParser",
     "LogLevel",
+    "Refusal",
     "RobotConnection",
     "RobotDisconnected",
     "RobotTopic",

@@ -31,6 +31,13 @@ class RosserialLimits:
     idle_timeout_s: float
     request_topics_interval_s: float
     poll_interval_s: float
+    handshake_timeout_s: float
+    max_pending_per_address: int
+    refusals_before_backoff: int
+    refusal_window_s: float
+    backoff_s: float
+    refusal_log_interval_s: float
+    max_tracked_addresses: int
 
     def __post_init__(self) -> None:
         for name in self.__slots__:
@@ -90,4 +97,28 @@ DEFAULT_LIMITS = RosserialLimits(
     request_topics_interval_s=1.0,
     # [s] how often timers (sync, silence, frame timeout) are checked for every connection.
     poll_interval_s=0.1,
+    # ---- admission (who gets a session at all; ros_lib has no authentication, see README)
+    # [s] a connection that has not finished the rosserial handshake (topics advertised and
+    # settled: READY) within this is closed, so sockets that connect and say nothing cannot hold
+    # a slot. ros_lib answers the topic request within milliseconds of its next spinOnce(); 10 s
+    # leaves room for a WiFi stall and a firmware still running its setup().
+    handshake_timeout_s=10.0,
+    # [connections] handshakes in progress from one address. A further one closes the oldest:
+    # a rebooted robot's new connection is the live one, and idle sockets from one address
+    # cannot fill max_connections.
+    max_pending_per_address=2,
+    # [refusals] an address refused this often within refusal_window_s is backed off: refused
+    # for backoff_s without a lookup or a log line. ros_lib retries about once a second, so a
+    # mistyped address in the inventory is still reported every minute.
+    refusals_before_backoff=5,
+    # [s] the window in which refusals are counted.
+    refusal_window_s=10.0,
+    # [s] how long a backed-off address is refused outright (only unregistered addresses are
+    # backed off; a robot refused while it is in a run is not, so it comes back when the run ends).
+    backoff_s=30.0,
+    # [s] one log line per refused address per this interval, so a flood does not fill the log.
+    refusal_log_interval_s=60.0,
+    # [addresses] refused addresses remembered for back-off and logging; the oldest are forgotten
+    # past this, so a sweep of spoofed addresses cannot grow the server's memory.
+    max_tracked_addresses=4096,
 )

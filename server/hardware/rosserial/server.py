@@ -8,7 +8,7 @@ shown to the rest of RoboDojo as a ``RobotConnection`` through a ``RosserialHand
         def on_robot_connected(self, robot): ...
         def on_message(self, robot, topic, message): robot.send("Control", Twist(...))
 
-    with RosserialServer(Bridge(), host="0.0.0.0", port=11411) as server:
+    with RosserialServer(Bridge(), host="10.42.0.1", port=11411) as server:  # the robots' LAN
         ...
 
 Threading: the server runs an asyncio event loop in its own thread ("rosserial"). Parsing is
@@ -18,6 +18,12 @@ control and a fixed read buffer (``asyncio.BufferedProtocol``). Handler methods 
 thread and must return quickly (hand over with ``loop.call_soon_threadsafe`` or a latest-value
 slot). ``RobotConnection.send``/``stop`` and ``RosserialServer.stop`` may be called from any
 thread; ``send`` checks the topic at once, in the caller's thread, and raises with a sentence.
+
+Admission (admission.py): ros_lib has no authentication, so before a session exists the server
+asks ``handler.admit(host)``; a refused peer is closed at once (no topic request, no slot), logged
+once a minute per address and backed off when it keeps connecting. Connections that do not finish
+the handshake within ``handshake_timeout_s`` are closed, and at most ``max_pending_per_address``
+handshakes run per address (the newest wins: a rebooted robot's connection is the live one).
 
 Unlike rosserial_python (one connection at a time unless forking) it serves up to
 ``max_connections`` robots at once; it requests topics at once instead of after 2 s (that sleep
@@ -37,6 +43,7 @@ from collections import Counter
 from collections.abc import Callable
 
 from sandbox.msgs import Message
+from server.hardware.rosserial.admission import AdmissionControl, Refusal
 from server.hardware.rosserial.limits import DEFAULT_LIMITS, RosserialLimits
 from server.hardware.rosserial.messages import LogLevel
 from server.hardware.rosserial.session import (
@@ -73,6 +80,11 @@ class RosserialHandler:
     a connected robot. Problems (refused topics, wrong protocol version...) and lost syncs also
     arrive as ``on_log`` lines at ERROR and WARN."""
 
+    def admit(self, host: str) -> Refusal | None:
+        """A peer connected from `host`: None gives it a session, a Refusal closes it at once.
+        Runs on the rosserial thread before anything is sent; must be quick. Default: admit."""
+        return None
+
     def on_robot_connected(self, robot: RobotConnection) -> None:
         """A robot finished negotiating its topics."""
 
@@ -101,6 +113,7 @@ class RobotConnection:
         self.peer = peer  # (host, port) of the robot
         self.session = session
         self.connected_at = time.time()  # [s] epoch
+        self.started_s = time.monotonic()  # [s] for the handshake timeout
         self.announced = False  # on_robot_connected has been called
         self.outgoing_dropped = 0  # frames not written: the robot stopped reading
         self.reads_paused = 0  # times reading paused for the rest of a second (max_bytes_per_s)
@@ -185,6 +198,9 @@ class _Connection(asyncio.BufferedProtocol):
         assert isinstance(transport, asyncio.Transport)
         server = self._server
         peer = transport.get_extra_info("peername") or ("?", 0)
+        if not server._admit(str(peer[0])):
+            transport.abort()
+            return
         if len(server._robots) >= server.limits.max_connections:
             logger.warning(
                 "rosserial: refused %s:%s, already %d robots connected (max_connections)",
@@ -264,7 +280,7 @@ class RosserialServer:
         self,
         handler: RosserialHandler | None = None,
         *,
-        host: str = "0.0.0.0",
+        host: str = "127.0.0.1",
         port: int = DEFAULT_PORT,
         limits: RosserialLimits = DEFAULT_LIMITS,
         clock_ns: Callable[[], int] = time.time_ns,
@@ -276,6 +292,7 @@ class RosserialServer:
         self.clock_ns = clock_ns
         self._robots: dict[str, RobotConnection] = {}
         self._ids = itertools.count(1)
+        self.admission = AdmissionControl(limits)
         self._loop: asyncio.AbstractEventLoop | None = None
         self._thread: threading.Thread | None = None
         self._listener: asyncio.Server | None = None
@@ -387,10 +404,47 @@ class RosserialServer:
             await self._listener.wait_closed()
         await asyncio.sleep(0.05)  # transports write their tx-stop and close
 
+    def _admit(self, host: str) -> bool:
+        """Ask the handler whether `host` gets a session (back-off first); make room among the
+        address's unfinished handshakes. False: close the peer now."""
+        now_s = time.monotonic()
+        if self.admission.backed_off(host, now_s):
+            return False
+        try:
+            refusal = self.handler.admit(host)
+        except Exception:
+            self.handler_errors += 1
+            logger.exception("rosserial: handler admit raised")
+            refusal = Refusal("the server could not check the address (see the error above)", False)
+        if refusal is not None:
+            self.admission.refuse(host, refusal, now_s)
+            return False
+        pending = sorted(
+            (r for r in self._robots.values() if r.peer[0] == host and not r.announced),
+            key=lambda r: r.started_s,
+        )
+        for old in pending[: max(0, len(pending) - self.limits.max_pending_per_address + 1)]:
+            self._dispatch(
+                old,
+                old.session.close(
+                    f"a newer connection from {host} came before this one finished its handshake"
+                ),
+            )
+        return True
+
     def _poll(self) -> None:
         now_s = time.monotonic()
+        limit_s = self.limits.handshake_timeout_s
         for robot in list(self._robots.values()):
             self._dispatch(robot, robot.session.poll(now_s))
+            if not robot.announced and robot.connected and now_s - robot.started_s > limit_s:
+                self._dispatch(
+                    robot,
+                    robot.session.close(
+                        f"no rosserial handshake within {limit_s:g} s of connecting (topics "
+                        "not advertised): closed so it cannot hold a connection slot"
+                    ),
+                )
         loop = self._loop
         if loop is not None and loop.is_running():
             loop.call_later(self.limits.poll_interval_s, self._poll)
