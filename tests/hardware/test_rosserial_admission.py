@@ -145,7 +145,7 @@ class OnlyRobot(RosserialHandler):
 
 def test_idle_sockets_from_a_registered_address_cannot_hold_the_slots():
     handler = OnlyRobot()
-    limits = dataclasses.replace(DEFAULT_LIMITS, max_connections=4, handshake_timeout_s=0.8)
+    limits = dataclasses.replace(DEFAULT_LIMITS, max_connections=4, handshake_timeout_s=3.0)
     assert limits.negotiation_timeout_s == 45.0  # the old, long bound is not what closes them
     with RosserialServer(handler, host=ROBOT, port=0, limits=limits) as server:
         idle = [connect_from(ROBOT, server.port) for _ in range(6)]
@@ -157,7 +157,7 @@ def test_idle_sockets_from_a_registered_address_cannot_hold_the_slots():
             with CrowBotFirmware(ROBOT, server.port) as firmware:
                 assert firmware.wait_until(lambda: firmware.configured, 5), "robot turned away"
                 assert firmware.wait_until(lambda: len(handler.ready) == 1, 5)
-                time.sleep(1.5)  # past the handshake timeout
+                time.sleep(3.5)  # past the handshake timeout (settle_s made the robot ready)
                 assert [r.id for r in server.robots()] == [handler.ready[0].id]
                 assert firmware.connected and firmware.configured  # the handshaken one stays
             closed = [first_bytes(sock, 0.5) for sock in idle]
