@@ -19,7 +19,9 @@ class Settings(BaseSettings):
     port: int = Field(8000, ge=0, le=65535)
     data: Path = Path("robodojo-data")  # SQLite file, recordings, artifacts
     database_url: str | None = None  # None: SQLite in `data`; else postgresql://...
-    public_url: str | None = None  # how browsers reach us, for printed links (behind a proxy)
+    # How browsers reach us (behind a proxy): printed links, and an origin the CSRF and websocket
+    # Origin checks accept besides the one a request came to (auth.py).
+    public_url: str | None = None
 
     # Limits that protect the lab: value and why.
     max_runs_per_student: int = Field(2, ge=1)  # two: one running, one being looked at

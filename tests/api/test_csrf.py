@@ -145,3 +145,23 @@ def test_resume_of_a_running_run_and_pause_of_a_paused_one_answer_409(lab):
     assert student.post(f"/api/runs/{run_id}/resume").status_code == 200
     student.post(f"/api/runs/{run_id}/stop")
     wait_for_end(student, run_id)
+
+
+def test_behind_a_proxy_the_public_url_is_the_labs_origin_too(tmp_path):
+    from tests.api.conftest import start_server, stop_server
+
+    public = "https://lab.example.org"
+    server = start_server(tmp_path / "lab", {"ROBODOJO_PUBLIC_URL": public})
+    try:
+        instructor = browser(server, server.admin_token)
+        for origin in (public, "https://lab.example.org:443", server.url):
+            answer = instructor.post(
+                "/api/admin/users", json={"name": "via proxy"}, headers={"Origin": origin}
+            )
+            assert answer.status_code == 201, (origin, answer.text)
+        answer = instructor.post(
+            "/api/admin/users", json={"name": "x"}, headers={"Origin": "https://evil.example.org"}
+        )
+        assert answer.status_code == 403, answer.text
+    finally:
+        stop_server(server)

@@ -145,3 +145,20 @@ def test_another_sites_page_cannot_open_the_socket_and_a_stale_client_is_told(la
         ws.recv(timeout=5)
     assert closed.value.rcvd.code == 1002
     wait_for_end(owner, run_id)
+
+
+def test_disabling_the_owner_closes_their_3d_view(lab):
+    owner = lab.student("disabled-viewer")
+    run_id = start_run(owner, duration_s=60.0)
+    with browser_socket(lab, owner, run_id) as ws:
+        messages_until(ws, is_robot_moving)
+        with lab.admin() as admin:
+            assert admin.post(f"/api/admin/users/{owner.user['id']}/disable").status_code == 200
+        with pytest.raises(ConnectionClosed) as closed:
+            deadline = time.monotonic() + ROBOT_WAIT_S
+            while time.monotonic() < deadline:
+                ws.recv(timeout=max(0.01, deadline - time.monotonic()))
+    assert closed.value.rcvd is not None and closed.value.rcvd.code == 1008
+    assert closed.value.rcvd.reason == "your account was disabled"
+    with lab.admin() as admin:
+        wait_for_end(admin, run_id)
