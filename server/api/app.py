@@ -19,6 +19,7 @@ from fastapi.staticfiles import StaticFiles
 from sandbox.launcher import Launcher
 from server.api import errors
 from server.api.auth import CsrfGuard
+from server.api.http_guards import BodyLimit, SecurityHeaders
 from server.api.routes import (
     admin,
     admin_courses,
@@ -44,7 +45,6 @@ from server.store.db import Store
 
 log = logging.getLogger("robodojo.api")
 WEB_DIR = Path(__file__).resolve().parents[2] / "web"
-MAX_BODY_BYTES = 4 * 1024 * 1024  # [B] above every code limit; a bigger body is refused early
 FIRST_INSTRUCTOR = "instructor"
 
 
@@ -111,19 +111,18 @@ def create_app(settings: Settings | None = None, launcher: Launcher | None = Non
     app.add_middleware(CsrfGuard)  # cookie-authenticated state changes from our own origin only
 
     @app.middleware("http")
-    async def limit_body(request: Request, call_next):
+    async def refuse_nul(request: Request, call_next):
         if "\x00" in request.url.path or "%00" in request.url.query:
             return JSONResponse(
                 status_code=400,
                 content={"detail": "the address holds a NUL character (%00); remove it"},
             )
-        length = request.headers.get("content-length")
-        if length is not None and (not length.isdigit() or int(length) > MAX_BODY_BYTES):
-            return JSONResponse(
-                status_code=413,
-                content={"detail": f"the request body is larger than {MAX_BODY_BYTES} bytes"},
-            )
         return await call_next(request)
+
+    # Added last, so outermost: the body is counted before any route, login or gzip sees it,
+    # and even its 413 carries the security headers.
+    app.add_middleware(BodyLimit, max_bytes=settings.max_request_body_bytes)
+    app.add_middleware(SecurityHeaders)
 
     for module in (session, catalog, workspaces, runs, live, admin, admin_runs, admin_courses,
                    admin_exercises, admin_robots, hardware, viz):  # fmt: skip

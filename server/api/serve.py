@@ -32,6 +32,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
 
     from sandbox.launcher import Launcher
     from server.api.app import create_app
+    from server.api.http_server import h11_with_header_timeout, install_redaction
     from server.store.db import Store
 
     settings = _settings(args)
@@ -44,17 +45,26 @@ def cmd_serve(args: argparse.Namespace) -> int:
         pool_size=settings.sandbox_pool, unsafe_no_sandbox=settings.unsafe_no_sandbox
     )
     try:
-        uvicorn.run(
+        config = uvicorn.Config(
             create_app(settings, launcher),
             host=settings.host,
             port=settings.port,
             log_level="info",
+            # h11 (not httptools) for its header size bound and our header timeout.
+            http=h11_with_header_timeout(settings.header_timeout_s),
+            h11_max_incomplete_event_size=settings.max_header_bytes,
+            timeout_keep_alive=settings.keep_alive_timeout_s,
             ws_max_size=1024 * 1024,  # [B] a websocket command is tiny; a megabyte is abuse
             # Telemetry and the 3D view send small JSON/msgpack at up to 60 Hz; compressing each
             # costs more than it saves on a lab network (viser's big point clouds: ~330 ms).
             ws_per_message_deflate=False,
             timeout_graceful_shutdown=int(settings.shutdown_grace_s) + 5,
         )
+        install_redaction()  # uvicorn.Config has just set up its loggers
+        server = uvicorn.Server(config)
+        server.run()
+        if not server.started:
+            return 3  # uvicorn.run's exit status when the server could not start (port in use)
     finally:
         launcher.close()
     return 0

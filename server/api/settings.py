@@ -32,6 +32,8 @@ class Settings(BaseSettings):
     max_files_per_workspace: int = Field(32, ge=1)  # a package: nodes, launch, config, data
     max_data_bytes_per_file: int = Field(1024 * KIB, ge=1)  # [B] a long CSV log, a big YAML map
     max_workspace_bytes: int = Field(4096 * KIB, ge=1)  # [B] newest versions; every run copies it
+    max_request_body_bytes: int = Field(4096 * KIB, ge=1)  # [B] above every code limit; counted
+    # as it arrives (chunked too), for every route, before login
     retry_after_s: int = Field(10, ge=1)  # [s] told to a client that hit a run limit
 
     # Real robots: CrowBots (ros_lib over WiFi) connect to this TCP port; rosserial_python's
@@ -51,6 +53,12 @@ class Settings(BaseSettings):
     hardware_gate: bool = True  # a hardware run needs the same code to have passed in simulation
     hardware_slot_s: float = Field(300.0, gt=0)  # [s] longest turn on a robot
     hardware_start_within_s: float = Field(60.0, gt=0)  # [s] a turn not started passes on
+
+    # HTTP connections (uvicorn, h11): a client that holds a connection without finishing a
+    # request must not hold it for long; 150 half-sent requests once stayed open forever.
+    header_timeout_s: float = Field(10.0, gt=0)  # [s] request line and headers must be in by then
+    keep_alive_timeout_s: int = Field(5, ge=1)  # [s] idle between requests (uvicorn's default)
+    max_header_bytes: int = Field(32 * KIB, ge=1024)  # [B] request line + headers (h11: 16 KiB)
 
     unsafe_no_sandbox: bool = False  # trusted machines only: student code runs unconfined
     sandbox_pool: int = Field(2, ge=0)  # warm sandbox processes kept ready

@@ -98,8 +98,14 @@ def new_page(browser):
         contexts.append(context)
         page = context.new_page()
         page.console_watch = ConsoleWatch(page)
+        pages.append(page)
         return page
 
+    pages = []
     yield make
     for context in contexts:
         context.close()
+    # The pages are served with a Content-Security-Policy (server/api/http_guards.py): anything
+    # it blocks shows as a console error, and fails every test whether it checks errors or not.
+    blocked = [e for page in pages for e in page.console_watch.errors if "Content Security" in e]
+    assert not blocked, blocked
