@@ -198,6 +198,8 @@ async def live(websocket: WebSocket, run_id: str) -> None:
 
     close_code, close_reason = 1000, ""
     async with app.state.sockets.held(caller.id) as revoked:
+        if await run_in_threadpool(websocket_user, websocket) is None:
+            revoked.set()  # disabled between the handshake's check and this registration
         tasks = [asyncio.create_task(reader()), asyncio.create_task(writer())]
         disabled = asyncio.create_task(revoked.wait())
         try:

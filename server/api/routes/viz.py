@@ -159,6 +159,8 @@ async def view_socket(websocket: WebSocket, run_id: str) -> None:
         async with upstream:
             await websocket.accept(subprotocol=upstream.subprotocol)
             async with websocket.app.state.sockets.held(caller.id) as revoked:
+                if await run_in_threadpool(websocket_user, websocket) is None:
+                    revoked.set()  # disabled between the handshake's check and now
                 await _pump(websocket, upstream, revoked)
 
 
