@@ -7,6 +7,7 @@ launcher and the run service started; on shutdown every run stopped cleanly.
 
 from __future__ import annotations
 
+import asyncio
 import contextlib
 import logging
 from pathlib import Path
@@ -36,6 +37,7 @@ from server.api.routes import (
 )
 from server.api.settings import Settings
 from server.api.sockets import OpenSockets
+from server.service import disk
 from server.service.hardware import HardwareHub
 from server.service.runs import RunService
 from server.store import accounts
@@ -55,6 +57,16 @@ def bootstrap(store: Store, settings: Settings) -> str | None:
             return None
         made = accounts.create_user(db, FIRST_INSTRUCTOR, Role.INSTRUCTOR)
     return f"{settings.base_url()}/login?token={made.token}"
+
+
+async def _retention_loop(store: Store, settings: Settings) -> None:
+    """At start and then every retention_sweep_s: measure ended runs, remove old runs' files."""
+    while True:
+        try:
+            await asyncio.to_thread(disk.sweep, store, settings)
+        except Exception:  # a failed sweep (a locked database) is tried again next time
+            log.exception("retention sweep failed")
+        await asyncio.sleep(settings.retention_sweep_s)
 
 
 def create_app(settings: Settings | None = None, launcher: Launcher | None = None) -> FastAPI:
@@ -87,9 +99,13 @@ def create_app(settings: Settings | None = None, launcher: Launcher | None = Non
         else:
             print(f"RoboDojo: serving at {settings.base_url()}/ (for a new instructor login "
                   "link: robodojo login-url)", flush=True)  # fmt: skip
+        sweeper = asyncio.create_task(_retention_loop(store, settings))
         try:
             yield
         finally:
+            sweeper.cancel()
+            with contextlib.suppress(asyncio.CancelledError):
+                await sweeper
             app.state.runs.shutdown()  # robots commanded to zero as their runs end
             app.state.hardware.stop()
             if own_launcher:

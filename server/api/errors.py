@@ -16,6 +16,7 @@ from starlette.exceptions import HTTPException as StarletteHTTPException
 
 from server.runs.spec import RunSpecError
 from server.service.catalog import UnknownIdError
+from server.service.disk import DiskBudgetError
 from server.service.exercises import ExerciseDefinitionError
 from server.service.runs import RunLimitError, RunRequestError
 from server.service.workspace_files import WorkspaceFileError
@@ -59,6 +60,11 @@ async def _run_limit(_: Request, error: RunLimitError) -> JSONResponse:
         content={"detail": str(error), "retry_after_s": error.retry_after_s},
         headers={"Retry-After": str(error.retry_after_s)},
     )
+
+
+async def _disk_budget(_: Request, error: DiskBudgetError) -> JSONResponse:
+    # 507 Insufficient Storage (RFC 4918 11.5): waiting does not help, freeing space does.
+    return JSONResponse(status_code=507, content={"detail": str(error)})
 
 
 async def _bad_run(_: Request, error: Exception) -> JSONResponse:
@@ -105,6 +111,7 @@ def install(app: FastAPI) -> None:
     app.add_exception_handler(StarletteHTTPException, _http)
     app.add_exception_handler(UnknownIdError, _unknown_id)
     app.add_exception_handler(RunLimitError, _run_limit)
+    app.add_exception_handler(DiskBudgetError, _disk_budget)
     app.add_exception_handler(RunRequestError, _bad_run)
     app.add_exception_handler(RunSpecError, _bad_run)
     app.add_exception_handler(WorkspaceFileError, _bad_file)

@@ -10,6 +10,8 @@ from pydantic import Field
 from pydantic_settings import BaseSettings, SettingsConfigDict
 
 KIB = 1024
+MIB = 1024 * KIB
+GIB = 1024 * MIB
 
 
 class Settings(BaseSettings):
@@ -34,6 +36,13 @@ class Settings(BaseSettings):
     max_workspace_bytes: int = Field(4096 * KIB, ge=1)  # [B] newest versions; every run copies it
     max_request_body_bytes: int = Field(4096 * KIB, ge=1)  # [B] above every code limit; counted
     # as it arrives (chunked too), for every route, before login
+    # Disk: a run leaves its recording, logs and artifacts (up to ~24 MiB of artifacts); runs
+    # still on disk count against these budgets, and retention removes old runs' files.
+    student_disk_budget_bytes: int = Field(500 * MIB, ge=0)  # [B] per student; 0 = no budget
+    lab_disk_budget_bytes: int = Field(20 * GIB, ge=0)  # [B] all runs together; 0 = no budget
+    retention_days: float = Field(0.0, ge=0)  # [days] ended runs' files kept; 0 = forever. The
+    # instructor can change it at run time (PUT /api/admin/retention), which wins over this.
+    retention_sweep_s: float = Field(3600.0, gt=0)  # [s] how often old runs' files are removed
     retry_after_s: int = Field(10, ge=1)  # [s] told to a client that hit a run limit
 
     # Real robots: CrowBots (ros_lib over WiFi) connect to this TCP port; rosserial_python's

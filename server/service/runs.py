@@ -29,6 +29,7 @@ from server.runs.result import RunResult
 from server.runs.run import Run
 from server.runs.spec import NodeSpec, RunSpec
 from server.runs.state import RunState
+from server.service import disk
 from server.service.catalog import ExerciseEntry
 from server.service.telemetry import RunTelemetry, TelemetryRegistry
 from server.store import robots as inventory
@@ -197,6 +198,8 @@ class RunService:
                     f"try again in {self.settings.retry_after_s} s",
                     self.settings.retry_after_s,
                 )
+            with self.store.session() as db:  # measured sizes, summed: no directory is walked
+                disk.check_budgets(db, user_id, self.settings)
             run_id = uuid.uuid4().hex
             run_dir = Path(self.settings.runs_dir) / run_id
             exercise = request.exercise
@@ -321,6 +324,7 @@ class RunService:
                 record.nodes = json_safe(result.summary()["nodes"])
             record.checks = json_safe(checks)
             record.score = score
+            record.disk_bytes = disk.dir_bytes(active.run.out_dir)  # once, for the budgets
         if checks:
             active.telemetry.on_event(
                 {"type": "checks", "checks": json_safe(checks), "score": score}

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from sqlalchemy import (
     JSON,
+    BigInteger,
     Boolean,
     Float,
     ForeignKey,
@@ -142,6 +143,21 @@ class RunRecord(Base):
     score: Mapped[float | None] = mapped_column(Float, nullable=True)  # 0..1, exercises only
     run_dir: Mapped[str] = mapped_column(Text)
     hardware: Mapped[str | None] = mapped_column(String(64), nullable=True)  # bench robot name
+    # [B] the run directory's size, measured when the run ended (None: not measured yet); the
+    # disk budgets add these up instead of walking every directory (server/service/disk.py).
+    disk_bytes: Mapped[int | None] = mapped_column(BigInteger, nullable=True)
+    files_removed_at: Mapped[float | None] = mapped_column(Float, nullable=True)  # by retention
+
+
+class LabSetting(Base):
+    """A setting an instructor changes while the lab runs (retention_days); it wins over the
+    ROBODOJO_* default of the same name."""
+
+    __tablename__ = "lab_settings"
+
+    key: Mapped[str] = mapped_column(String(64), primary_key=True)
+    value: Mapped[dict] = mapped_column(JSON)  # {"value": ...}
+    updated_at: Mapped[float] = mapped_column(Float)
 
 
 class RobotEntry(Base):

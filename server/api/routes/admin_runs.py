@@ -1,4 +1,5 @@
-"""Instructor admin API, runs: everyone's runs with filters, stop any run, the server's status."""
+"""Instructor admin API, runs: everyone's runs with filters, stop any run, the server's status
+(with the disk used by runs), the retention of old runs' files."""
 
 from __future__ import annotations
 
@@ -9,11 +10,13 @@ from typing import Literal
 
 import psutil
 from fastapi import APIRouter, Depends, HTTPException, Query, Request
+from pydantic import BaseModel, Field
 from sqlalchemy import select
 
 from server.api.auth import Caller, instructor
 from server.api.routes.runs import run_out
 from server.runs.state import RunState
+from server.service import disk
 from server.store import runs as run_store
 from server.store.models import User
 
@@ -96,6 +99,7 @@ def status(request: Request, _: Caller = Depends(instructor)) -> dict:
     service = request.app.state.runs
     with request.app.state.store.session() as db:
         stored_active = run_store.active_count(db)
+        disk_use = disk.disk_status(db, request.app.state.settings)
     return {
         "uptime_s": round(time.time() - STARTED, 1),
         "runs": service.status(),
@@ -114,9 +118,35 @@ def status(request: Request, _: Caller = Depends(instructor)) -> dict:
         },
         "queues": {"waiting_runs": 0, "note": "runs start at once or are refused with 429"},
         "database": request.app.state.store.dialect,
+        "disk": disk_use,
         "hardware": {
             "rosserial_port": request.app.state.hardware.port,
             "listening": request.app.state.hardware.listen_error or "yes",
             "problems": request.app.state.hardware.problems(),
         },
+    }
+
+
+class RetentionIn(BaseModel):
+    retention_days: float = Field(
+        ge=0, le=3650, description="days ended runs keep their files; 0 = forever"
+    )
+
+
+@router.get("/retention", summary="How long ended runs keep their files (0 = forever)")
+def get_retention(request: Request, _: Caller = Depends(instructor)) -> dict:
+    with request.app.state.store.session() as db:
+        return {"retention_days": disk.retention_days(db, request.app.state.settings)}
+
+
+@router.put("/retention", summary="Set the retention; old runs' files are removed at once")
+def set_retention(body: RetentionIn, request: Request, _: Caller = Depends(instructor)) -> dict:
+    store, settings = request.app.state.store, request.app.state.settings
+    with store.session() as db:
+        disk.set_retention_days(db, body.retention_days)
+    swept = disk.sweep(store, settings)  # the instructor sees the effect now, not in an hour
+    return {
+        "retention_days": body.retention_days,
+        "runs_with_files_removed_now": swept.removed,
+        "freed_bytes": swept.freed_bytes,
     }

@@ -23,7 +23,7 @@ from server.runs.recorder import ARTIFACTS_DIR, LOGS_DIR, RECORDING_FILE
 from server.runs.safe_paths import inside, safe_relative_path
 from server.runs.spec import NodeSpec
 from server.runs.state import RunState
-from server.service import catalog, exercises, workspace_files, workspace_runs
+from server.service import catalog, disk, exercises, workspace_files, workspace_runs
 from server.service.runs import RunRequest, RunService, node_spec
 from server.store import runs as run_store
 from server.store.models import RunRecord
@@ -69,6 +69,8 @@ def run_out(record: RunRecord, service: RunService, with_code: bool = False) -> 
         "nodes": record.nodes,
         "checks": record.checks,
         "score": record.score,
+        "disk_bytes": record.disk_bytes,  # [B] measured when the run ended
+        "files_removed": record.files_removed_at is not None,  # by the lab's retention
         "links": {
             "self": f"/api/runs/{record.id}",
             "live": f"/api/runs/{record.id}/live",
@@ -95,6 +97,16 @@ def visible_run(request: Request, caller: Caller, run_id: str) -> RunRecord:
         record = run_store.get(db, run_id)
     if record is None or not caller.can_see(record.user_id):
         raise HTTPException(404, NOT_FOUND)
+    return record
+
+
+def files_of(request: Request, caller: Caller, run_id: str) -> RunRecord:
+    """A run whose files are asked for: 410 Gone when retention removed them."""
+    record = visible_run(request, caller, run_id)
+    if record.files_removed_at is not None:
+        with request.app.state.store.session() as db:
+            days = disk.retention_days(db, request.app.state.settings)
+        raise HTTPException(410, disk.files_removed_sentence(record, days))
     return record
 
 
@@ -276,7 +288,7 @@ def _run_file(record: RunRecord, relative: str) -> Path:
 
 @router.get("/{run_id}/recording.mcap", summary="The run's recording (MCAP, as rosbag2 for ROS 2)")
 def recording(run_id: str, request: Request, caller: Caller = Depends(current_user)):
-    record = visible_run(request, caller, run_id)
+    record = files_of(request, caller, run_id)
     path = Path(record.run_dir) / RECORDING_FILE
     if not path.is_file():
         raise HTTPException(404, "this run has no recording (it failed before it started)")
@@ -287,7 +299,7 @@ def recording(run_id: str, request: Request, caller: Caller = Depends(current_us
 
 @router.get("/{run_id}/csv", summary="The topics with a CSV file each (after the run ended)")
 def csv_list(run_id: str, request: Request, caller: Caller = Depends(current_user)) -> dict:
-    record = visible_run(request, caller, run_id)
+    record = files_of(request, caller, run_id)
     folder = _export(request, record)
     return {
         "files": [
@@ -299,7 +311,7 @@ def csv_list(run_id: str, request: Request, caller: Caller = Depends(current_use
 
 @router.get("/{run_id}/csv/{name}", summary="One topic as CSV")
 def csv_file(run_id: str, name: str, request: Request, caller: Caller = Depends(current_user)):
-    record = visible_run(request, caller, run_id)
+    record = files_of(request, caller, run_id)
     folder = _export(request, record)
     wanted = name if name.endswith(".csv") else csv_file_name(name)
     path = folder / wanted
@@ -325,7 +337,7 @@ def _export(request: Request, record: RunRecord) -> Path:
 
 @router.get("/{run_id}/logs", summary="What each node printed")
 def logs(run_id: str, request: Request, caller: Caller = Depends(current_user)) -> dict:
-    record = visible_run(request, caller, run_id)
+    record = files_of(request, caller, run_id)
     active = service_of(request).active(record.id)
     if active is not None:
         return {"nodes": {name: list(slot.logs) for name, slot in active.run.slots.items()}}
@@ -339,21 +351,21 @@ def logs(run_id: str, request: Request, caller: Caller = Depends(current_user)) 
 
 @router.get("/{run_id}/logs/{node}.log", summary="One node's log as text")
 def log_file(run_id: str, node: str, request: Request, caller: Caller = Depends(current_user)):
-    record = visible_run(request, caller, run_id)
+    record = files_of(request, caller, run_id)
     path = _run_file(record, f"{LOGS_DIR}/{node}.log")
     return PlainTextResponse(path.read_text("utf-8", errors="replace"))
 
 
 @router.get("/{run_id}/metrics.json", summary="Full metrics with histograms")
 def metrics_file(run_id: str, request: Request, caller: Caller = Depends(current_user)):
-    record = visible_run(request, caller, run_id)
+    record = files_of(request, caller, run_id)
     path = _run_file(record, "metrics.json")
     return json.loads(path.read_text("utf-8"))
 
 
 @router.get("/{run_id}/graph", summary="Nodes and topics with measured rates (rqt_graph)")
 def graph(run_id: str, request: Request, caller: Caller = Depends(current_user)) -> dict:
-    record = visible_run(request, caller, run_id)
+    record = files_of(request, caller, run_id)
     active = service_of(request).active(record.id)
     if active is not None:
         return active.run.bus.graph()
@@ -362,7 +374,7 @@ def graph(run_id: str, request: Request, caller: Caller = Depends(current_user))
 
 @router.get("/{run_id}/artifacts", summary="Files the nodes saved")
 def artifact_list(run_id: str, request: Request, caller: Caller = Depends(current_user)) -> dict:
-    record = visible_run(request, caller, run_id)
+    record = files_of(request, caller, run_id)
     folder = Path(record.run_dir) / ARTIFACTS_DIR
     files = []
     if folder.is_dir():
@@ -380,6 +392,6 @@ def artifact_list(run_id: str, request: Request, caller: Caller = Depends(curren
 
 @router.get("/{run_id}/artifacts/{name:path}", summary="One saved file")
 def artifact(run_id: str, name: str, request: Request, caller: Caller = Depends(current_user)):
-    record = visible_run(request, caller, run_id)
+    record = files_of(request, caller, run_id)
     path = _run_file(record, f"{ARTIFACTS_DIR}/{name}")
     return FileResponse(path, filename=path.name)
