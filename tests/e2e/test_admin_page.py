@@ -109,6 +109,14 @@ def test_instructor_console_in_chromium(web_lab, new_page, screenshots) -> None:
     expect(row).to_have_count(0, timeout=20_000)
     assert wait_for_end(student, run_id)["state"] == "interrupted"
 
+    # The status shows the disk the ended run uses (measured when it ended), and who uses it.
+    ended = student.get(f"/api/runs/{run_id}").json()
+    assert ended["disk_bytes"] > 0
+    page.goto(f"{lab.url}/admin#status")
+    panel = page.get_by_test_id("status-panel")
+    expect(panel).to_contain_text("Disk used by runs", timeout=10_000)
+    expect(panel).to_contain_text(re.compile(r"most: Grace Hopper \d+\.\d MiB"))
+
     # A course: made, the student enrolled, an exercise assigned, the grade book shown.
     page.goto(f"{lab.url}/admin#courses")
     page.get_by_test_id("create-course-form").get_by_label("New course").fill("Navy 101")

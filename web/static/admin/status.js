@@ -29,6 +29,29 @@ function hardwareCard(hw) {
   );
 }
 
+function mib(bytes) {
+  return bytes == null ? "?" : `${(bytes / 2 ** 20).toFixed(1)} MiB`;
+}
+
+// Disk used by runs still on disk (measured as each ended), the budgets, the top students.
+function diskCard(disk) {
+  if (!disk) return null;
+  const budget = (bytes) => (bytes ? mib(bytes) : "none");
+  const top = (disk.top_students || [])
+    .slice(0, 3)
+    .map((s) => `${s.name} ${mib(s.bytes)}`)
+    .join(", ");
+  const days = disk.retention_days;
+  return card(
+    "Disk used by runs",
+    mib(disk.runs_bytes),
+    `budgets: lab ${budget(disk.lab_budget_bytes)}, per student ${budget(disk.student_budget_bytes)}`,
+    top ? `most: ${top}` : "no run files yet",
+    days ? `retention: files kept ${days} days; ${disk.runs_with_files_removed} run(s) removed`
+      : "retention: files kept forever (PUT /api/admin/retention to change)",
+  );
+}
+
 function render(s) {
   const runs = s.runs || {};
   const byState = Object.entries(runs.active_by_state || {})
@@ -64,6 +87,7 @@ function render(s) {
       `${machine.memory_available_mib ?? "?"} MiB available`,
       `server process: ${server.rss_mib ?? "?"} MiB resident`,
     ),
+    diskCard(s.disk),
     hardwareCard(s.hardware),
     card(
       "Server",
