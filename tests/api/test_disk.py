@@ -54,7 +54,11 @@ def _runs_of(lab: LabServer, user_id: str) -> list[dict]:
 
 def test_a_student_over_budget_and_a_lab_over_budget_get_a_sentence_and_no_run(disk_lab):
     ada = disk_lab.student("ada")
-    first = ada.post("/api/runs", json=short_run())
+    graded = {"exercise": "crowbot_distance_pid", "duration": 2,
+              "nodes": [{"name": "pid", "code": STEP_CONTROLLER}]}  # fmt: skip
+    first = ada.post(
+        "/api/runs", json=graded
+    )  # judged: its checks and score must outlive its files
     assert first.status_code == 201, first.text
     ended = wait_for_end(ada, first.json()["id"])
     run_dir = disk_lab.data / "runs" / ended["id"]
@@ -94,7 +98,8 @@ def test_retention_removes_old_runs_files_and_keeps_their_metrics(disk_lab):
     (ada_run,) = admin.get("/api/admin/runs").json()["runs"]
     run_id = ada_run["id"]
     before = admin.get(f"/api/runs/{run_id}").json()
-    assert before["metrics"] and not before["files_removed"]
+    assert before["metrics"] and before["checks"] and before["score"] is not None
+    assert not before["files_removed"]
     assert admin.get(f"/api/runs/{run_id}/recording.mcap").status_code == 200
 
     time.sleep(0.2)  # the run ended more than 0.1 s ago, so a retention of ~0.09 s takes it
