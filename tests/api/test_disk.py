@@ -56,9 +56,8 @@ def test_a_student_over_budget_and_a_lab_over_budget_get_a_sentence_and_no_run(d
     ada = disk_lab.student("ada")
     graded = {"exercise": "crowbot_distance_pid", "duration": 2,
               "nodes": [{"name": "pid", "code": STEP_CONTROLLER}]}  # fmt: skip
-    first = ada.post(
-        "/api/runs", json=graded
-    )  # judged: its checks and score must outlive its files
+    # A judged run: retention must keep its checks and score (the last test).
+    first = ada.post("/api/runs", json=graded)
     assert first.status_code == 201, first.text
     ended = wait_for_end(ada, first.json()["id"])
     run_dir = disk_lab.data / "runs" / ended["id"]
