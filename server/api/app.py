@@ -46,7 +46,8 @@ from server.store.accounts import Role
 from server.store.db import Store
 
 log = logging.getLogger("robodojo.api")
-WEB_DIR = Path(__file__).resolve().parents[2] / "web"
+# web/ through the server/web_assets link, so a wheel carries the pages inside the package.
+WEB_DIR = Path(__file__).resolve().parents[1] / "web_assets"
 FIRST_INSTRUCTOR = "instructor"
 
 
