@@ -114,7 +114,39 @@ def service_of(request: Request) -> RunService:
     return request.app.state.runs
 
 
-@router.post("", status_code=201, summary="Start a run (an exercise, or a robot in a world)")
+def file_answer(*media_types: str) -> dict:
+    """A route's OpenAPI `responses` for a file: its real content type(s), not FastAPI's
+    default JSON (which clients and schemathesis' content-type check would believe)."""
+    binary = {"schema": {"type": "string", "format": "binary"}}
+    return {200: {"description": "the file", "content": {m: binary for m in media_types}}}
+
+
+# OpenAPI links from a started run to what can be read or done with it (OpenAPI 3.1 section
+# 4.8.20): clients and schemathesis' stateful tests follow `id` instead of guessing `run_id`.
+RUN_LINKS = {
+    f"{method}{path.replace('/', '_').replace('.', '_')}": {
+        "operationRef": "#/paths/~1api~1runs~1{run_id}" + path.replace("/", "~1") + f"/{method}",
+        "parameters": {"run_id": "$response.body#/id"},
+    }
+    for method, path in [
+        ("get", ""),
+        ("get", "/logs"),
+        ("get", "/csv"),
+        ("get", "/metrics.json"),
+        ("get", "/graph"),
+        ("get", "/artifacts"),
+        ("get", "/recording.mcap"),
+        ("post", "/stop"),
+    ]
+}
+
+
+@router.post(
+    "",
+    status_code=201,
+    summary="Start a run (an exercise, or a robot in a world)",
+    openapi_extra={"responses": {"201": {"links": RUN_LINKS}}},
+)
 def create(body: RunCreate, request: Request, caller: Caller = Depends(current_user)) -> dict:
     service = service_of(request)
     entry = None
@@ -286,7 +318,12 @@ def _run_file(record: RunRecord, relative: str) -> Path:
     return path
 
 
-@router.get("/{run_id}/recording.mcap", summary="The run's recording (MCAP, as rosbag2 for ROS 2)")
+@router.get(
+    "/{run_id}/recording.mcap",
+    summary="The run's recording (MCAP, as rosbag2 for ROS 2)",
+    response_class=FileResponse,
+    responses=file_answer("application/octet-stream"),
+)
 def recording(run_id: str, request: Request, caller: Caller = Depends(current_user)):
     record = files_of(request, caller, run_id)
     path = Path(record.run_dir) / RECORDING_FILE
@@ -309,7 +346,12 @@ def csv_list(run_id: str, request: Request, caller: Caller = Depends(current_use
     }
 
 
-@router.get("/{run_id}/csv/{name}", summary="One topic as CSV")
+@router.get(
+    "/{run_id}/csv/{name}",
+    summary="One topic as CSV",
+    response_class=FileResponse,
+    responses=file_answer("text/csv"),
+)
 def csv_file(run_id: str, name: str, request: Request, caller: Caller = Depends(current_user)):
     record = files_of(request, caller, run_id)
     folder = _export(request, record)
@@ -349,7 +391,12 @@ def logs(run_id: str, request: Request, caller: Caller = Depends(current_user)) 
     return {"nodes": nodes}
 
 
-@router.get("/{run_id}/logs/{node}.log", summary="One node's log as text")
+@router.get(
+    "/{run_id}/logs/{node}.log",
+    summary="One node's log as text",
+    response_class=PlainTextResponse,
+    responses=file_answer("text/plain"),
+)
 def log_file(run_id: str, node: str, request: Request, caller: Caller = Depends(current_user)):
     record = files_of(request, caller, run_id)
     path = _run_file(record, f"{LOGS_DIR}/{node}.log")
@@ -390,7 +437,12 @@ def artifact_list(run_id: str, request: Request, caller: Caller = Depends(curren
     return {"files": files}
 
 
-@router.get("/{run_id}/artifacts/{name:path}", summary="One saved file")
+@router.get(
+    "/{run_id}/artifacts/{name:path}",
+    summary="One saved file",
+    response_class=FileResponse,
+    responses=file_answer("*/*"),
+)
 def artifact(run_id: str, name: str, request: Request, caller: Caller = Depends(current_user)):
     record = files_of(request, caller, run_id)
     path = _run_file(record, f"{ARTIFACTS_DIR}/{name}")

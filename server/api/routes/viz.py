@@ -32,7 +32,7 @@ from websockets.asyncio.client import connect
 from websockets.exceptions import ConnectionClosed, InvalidHandshake
 
 from server.api.auth import Caller, current_user, foreign_origin, websocket_user
-from server.api.routes.runs import NOT_FOUND, visible_run
+from server.api.routes.runs import NOT_FOUND, file_answer, visible_run
 from server.api.sockets import REVOKED_CODE, REVOKED_REASON
 from server.store import runs as run_store
 from server.viz.manager import LOOPBACK, VizManager
@@ -85,6 +85,8 @@ def view_redirect(run_id: str, request: Request, caller: Caller = Depends(curren
 @router.get(
     "/api/runs/{run_id}/viz/{asset:path}",
     summary="The run's 3D view (viser's client page; its websocket is the same path without /)",
+    response_class=Response,
+    responses=file_answer("*/*"),  # viser's page, scripts, styles and images
 )
 async def view_page(
     run_id: str, asset: str, request: Request, caller: Caller = Depends(current_user)
