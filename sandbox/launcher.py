@@ -24,8 +24,7 @@ import threading
 import time
 from collections import deque
 
-from sandbox import bwrap
-from sandbox.cgroups import Cgroups
+from sandbox import bwrap, cgroups
 from sandbox.limits import DEFAULT_LIMITS, Limits
 from sandbox.node_process import NodeProcess, NodeState, NodeUsageError
 
@@ -63,9 +62,9 @@ class Launcher:
             )
         self.sandboxed = not unsafe_no_sandbox
         self.font_cache = bwrap.prepare_font_cache()
-        self.cgroups = Cgroups.detect() if self.sandboxed else None
-        if self.sandboxed and self.cgroups is None:
-            log.info("no writable cgroup v1 memory/pids hierarchy: nodes run with rlimits only")
+        self.cgroups = cgroups.detect() if self.sandboxed else None
+        if self.sandboxed:
+            log.info("node limits: %s", cgroups.describe(self.cgroups))
         self._pool: deque[NodeProcess] = deque()
         self._lock = threading.Lock()
         self._closed = False

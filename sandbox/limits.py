@@ -23,6 +23,10 @@ class Limits:
     memory_bytes: int = 768 * MiB
     # Threads and processes together (pids cgroup): the interpreter and BLAS need a handful.
     max_pids: int = 32
+    # CPU bandwidth (cgroup v2 cpu.max, "quota period" in microseconds): one core's worth, so a
+    # spinning node cannot take both cores of a 2-core lab machine from the server and the others.
+    cpu_quota_us: int = 100_000
+    cpu_period_us: int = 100_000
     # CPU seconds for the node's whole life: a run of several minutes at a few percent CPU fits
     # easily; a spinning node is killed by the step budget long before this.
     cpu_seconds: int = 900

@@ -23,7 +23,7 @@ from dataclasses import asdict
 from enum import StrEnum
 
 from sandbox import bwrap
-from sandbox.cgroups import Cgroups, NodeCgroup, enter_and_exec
+from sandbox.cgroups import Cgroups, CgroupsV2, NodeCgroup, enter_and_exec
 from sandbox.limits import Limits
 from sandbox.logstream import LogStream
 from sandbox.protocol import (
@@ -82,7 +82,7 @@ class NodeProcess:
         limits: Limits,
         sandboxed: bool,
         font_cache: str | None = None,
-        cgroups: Cgroups | None = None,
+        cgroups: Cgroups | CgroupsV2 | None = None,
     ) -> None:
         self.limits = limits
         self.sandboxed = sandboxed
@@ -115,7 +115,7 @@ class NodeProcess:
                 )
                 env, cwd = None, None
                 if cgroups is not None:
-                    self.cgroup = cgroups.create(limits.memory_bytes, limits.max_pids)
+                    self.cgroup = cgroups.create(limits)
                     command = enter_and_exec(self.cgroup, command)
             else:
                 # DANGER path: a plain child process in a throw-away directory.
