@@ -111,7 +111,7 @@ def test_retention_removes_old_runs_files_and_keeps_their_metrics(disk_lab):
     after = admin.get(f"/api/runs/{run_id}").json()
     assert after["files_removed"] and after["metrics"] == before["metrics"]
     assert after["score"] == before["score"] and after["checks"] == before["checks"]
-    for path in ("recording.mcap", "logs", "artifacts", "metrics.json"):
+    for path in ("recording.mcap", "logs", "artifacts", "metrics.json", "viz/"):
         gone = admin.get(f"/api/runs/{run_id}/{path}")
         assert gone.status_code == 410, (path, gone.text)
         assert "removed by the lab's retention" in gone.json()["detail"]

@@ -32,7 +32,7 @@ from websockets.asyncio.client import connect
 from websockets.exceptions import ConnectionClosed, InvalidHandshake
 
 from server.api.auth import Caller, current_user, foreign_origin, websocket_user
-from server.api.routes.runs import NOT_FOUND, file_answer, visible_run
+from server.api.routes.runs import NOT_FOUND, file_answer, files_of, visible_run
 from server.api.sockets import REVOKED_CODE, REVOKED_REASON
 from server.store import runs as run_store
 from server.viz.manager import LOOPBACK, VizManager
@@ -91,7 +91,7 @@ def view_redirect(run_id: str, request: Request, caller: Caller = Depends(curren
 async def view_page(
     run_id: str, asset: str, request: Request, caller: Caller = Depends(current_user)
 ) -> Response:
-    record = await run_in_threadpool(visible_run, request, caller, run_id)
+    record = await run_in_threadpool(files_of, request, caller, run_id)
     session = await _session(request, record)
     status, headers, body = await run_in_threadpool(
         _fetch, session.port, "/" + asset, request.headers.get("accept-encoding", "")
