@@ -9,6 +9,7 @@ import numpy as np
 from server.exercises.checks import collisions, mean_abs_error, readings, settling_time_s
 from server.exercises.evidence import Evidence
 from server.exercises.model import Check, Comparison, Exercise, ScriptEvent
+from server.runs.commands import Button, Light
 
 SETPOINT_M = 0.2  # d_d [m], Table 2
 BAND_M = 0.02  # [m] "steady-state error under 2 cm"
@@ -115,7 +116,7 @@ LIGHT_TRACKING = Exercise(
     duration_s=32.0,
     seeds=(1, 2),
     spawn="centre",
-    script=tuple(ScriptEvent(t, "light", ("lamp", x, y)) for t, (x, y) in LAMP_MOVES),
+    script=tuple(ScriptEvent(t, Light(x, y, name="lamp")) for t, (x, y) in LAMP_MOVES),
     reference=(("light_tracker", "reference/crowbot_light_tracking.py"),),
     starter=(("light_tracker", "starter/crowbot_light_tracking.py"),),
     checks=(
@@ -171,10 +172,10 @@ DATA_LOGGER = Exercise(
     duration_s=LOGGER_DURATION_S,
     seeds=(1,),
     script=(
-        ScriptEvent(3.0, "button", True),
-        ScriptEvent(4.0, "button", False),
-        ScriptEvent(9.0, "button", True),
-        ScriptEvent(10.5, "button", False),
+        ScriptEvent(3.0, Button(True)),
+        ScriptEvent(4.0, Button(False)),
+        ScriptEvent(9.0, Button(True)),
+        ScriptEvent(10.5, Button(False)),
     ),
     reference=(("data_logger", "reference/crowbot_data_logger.py"),),
     starter=(("data_logger", "starter/crowbot_data_logger.py"),),

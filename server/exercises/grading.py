@@ -102,7 +102,7 @@ def run_spec(
         initial_pose=initial_pose or exercise.initial_pose,
         light_position=exercise.light_position,
         params=dict(exercise.params),
-        script=tuple((e.time_s, e.action, e.value) for e in exercise.script),
+        script=tuple((e.time_s, e.command) for e in exercise.script),
         builtin_nodes=exercise.builtin_nodes,
     )
 

@@ -16,6 +16,7 @@ from sandbox.protocol import Clock
 
 if TYPE_CHECKING:
     from server.exercises.evidence import Evidence
+    from server.runs.commands import RunCommand
 
 EXERCISE_DIR = Path(__file__).resolve().parent
 
@@ -51,12 +52,11 @@ class Check:
 
 @dataclass(frozen=True, slots=True)
 class ScriptEvent:
-    """Something the exercise does at run time `time_s` [s]: ("light", (name, x, y)),
-    ("goal", (x, y, yaw)), ("button", pressed)."""
+    """Something the exercise does at run time `time_s` [s]: a command of
+    server/runs/commands.py such as Light(x, y, name="lamp"), Goal(x, y, yaw), Button(pressed)."""
 
     time_s: float
-    action: str
-    value: object
+    command: RunCommand
 
 
 @dataclass(frozen=True, slots=True)

@@ -1,19 +1,32 @@
-"""Controls while a run runs: stop, pause/resume (lockstep), the robot's button, a light, a goal
-pose, a fault. Any thread may call them (the web server's, the CLI's signal handler); they are
-queued and applied by the run's own loop between two steps, so the simulation never sees two
-threads. A byte on a pipe wakes a realtime loop that is sleeping until its next event.
+"""Commands while a run runs (server/runs/commands.py): stop, pause/resume (lockstep), the
+robot's button, a light, a goal pose, a key, a fault. Any thread may send them (the web
+server's, the CLI's signal handler); they are queued and applied by the run's own loop between
+two steps, so the simulation never sees two threads. A byte on a pipe wakes a realtime loop
+that is sleeping until its next event.
 """
 
 from __future__ import annotations
 
 import contextlib
 import logging
-import math
 import os
 import queue
 from typing import TYPE_CHECKING
 
 from sandbox.protocol import Clock
+from server.runs.commands import (
+    Button,
+    CommandError,
+    EmergencyStop,
+    Goal,
+    InjectFault,
+    Light,
+    Pause,
+    Resume,
+    RunCommand,
+    Stop,
+    Teleop,
+)
 from server.runs.faults import Fault, FaultKind
 from server.runs.result import RunEnd
 from server.runs.state import RunState
@@ -40,50 +53,29 @@ class RunControls:
             with contextlib.suppress(OSError):
                 os.close(fd)
 
+    def command(self, command: RunCommand) -> None:
+        """Take a command (server/runs/commands.py) from any thread; it is applied by the run's
+        loop between two steps. Raises CommandError when the run's state refuses it now."""
+        if isinstance(command, Pause):
+            if self.spec.clock is not Clock.LOCKSTEP:
+                raise CommandError(
+                    "only a lockstep (simulated-time) run can pause; stop it instead"
+                )
+            if self.state is RunState.PAUSED:
+                raise CommandError("the run is already paused; resume it to go on")
+        elif isinstance(command, Resume) and self.state is not RunState.PAUSED:
+            raise CommandError(f"the run is not paused (it is {self.state}); nothing to resume")
+        elif isinstance(command, Teleop) and self.builtins.get("teleop") is None:
+            raise CommandError("this run takes no keyboard driving (its exercise has no teleop)")
+        elif isinstance(command, EmergencyStop) and self.backend is not None:
+            self.backend.stop()  # a real robot stops now, from this thread, not at the next step
+        self._control(command)
+
     def stop(self, reason: str = "stopped by the user") -> None:
-        self._control(("stop", reason))
+        self.command(Stop(reason))
 
-    def pause(self) -> None:
-        if self.spec.clock is not Clock.LOCKSTEP:
-            raise ValueError("only a lockstep (simulated-time) run can pause; stop it instead")
-        if self.state is RunState.PAUSED:
-            raise ValueError("the run is already paused; resume it to go on")
-        self._control(("pause", None))
-
-    def resume(self) -> None:
-        if self.state is not RunState.PAUSED:
-            raise ValueError(f"the run is not paused (it is {self.state}); nothing to resume")
-        self._control(("resume", None))
-
-    def press_button(self, pressed: bool) -> None:
-        self._control(("button", bool(pressed)))
-
-    def move_light(self, name: str, x: float, y: float) -> None:
-        self._control(("light", (name, float(x), float(y))))
-
-    def set_goal(self, x: float, y: float, yaw: float = 0.0) -> None:
-        if not all(math.isfinite(v) for v in (x, y, yaw)):
-            raise ValueError(f"a goal needs finite numbers, got ({x}, {y}, {yaw})")
-        self._control(("goal", (float(x), float(y), float(yaw))))
-
-    def inject_fault(self, kind: FaultKind | str, topic: str | None, duration_s: float) -> None:
-        kind = FaultKind(kind)
-        if kind is not FaultKind.STALL_MOTORS and not topic:
-            raise ValueError(f"fault {kind} needs the topic it affects")
-        if not (math.isfinite(duration_s) and duration_s > 0):
-            raise ValueError(f"a fault lasts a positive number of seconds, got {duration_s}")
-        self._control(("fault", (kind, topic, duration_s)))
-
-    def teleop(self, key: str, pressed: bool) -> None:
-        """An arrow key pressed or released in the browser (needs the `teleop` built-in)."""
-        from server.runs.builtin import TELEOP_KEYS
-
-        if key not in TELEOP_KEYS:
-            raise ValueError(f"teleop knows the keys {', '.join(TELEOP_KEYS)}, not '{key}'")
-        self._control(("teleop", (str(key), bool(pressed))))
-
-    def _control(self, action: tuple[str, object]) -> None:
-        self._controls.put(action)
+    def _control(self, command: RunCommand) -> None:
+        self._controls.put(command)
         # Wake a realtime loop that sleeps until its next event (see clocks.run_realtime).
         with contextlib.suppress(BlockingIOError, OSError):
             os.write(self._control_signal_w, b"!")
@@ -105,45 +97,46 @@ class RunControls:
             os.read(self._control_signal_r, 4096)
         while True:
             try:
-                action, value = self._controls.get_nowait()
+                command = self._controls.get_nowait()
             except queue.Empty:
                 return
-            self._apply_control(action, value)
+            self._apply_command(command)
 
-    def _apply_control(self, action: str, value: object) -> None:
-        if action == "stop":
-            raise RunEnd(RunState.INTERRUPTED, f"interrupted: {value}")
-        if action == "pause" and self.state is RunState.RUNNING:
-            self._move(RunState.PAUSED)
-        elif action == "resume" and self.state is RunState.PAUSED:
-            self._move(RunState.RUNNING)
-        elif action == "button":
-            self.sim.press_button(value)
-        elif action == "light":
-            name, x, y = value
-            try:
-                self.sim.move_light(name, x, y)
-            except SimulationError as error:
-                log.info("run %s: light not moved: %s", self.run_id, error)
-        elif action == "goal":
-            self._publish_goal(*value)
-        elif action == "teleop":
-            teleop = self.builtins.get("teleop")
-            if teleop is None:
-                log.info("run %s: a teleop key, but the run has no teleop node", self.run_id)
-            else:
-                teleop.key(*value)
-        elif action == "fault":
-            kind, topic, duration_s = value
-            kind = FaultKind(kind)
-            self.faults.add(Fault(kind, topic, self.time_ns + round(duration_s * NS)))
-            if kind is FaultKind.STALL_MOTORS:
-                self._stall_motors()
+    def _apply_command(self, command: RunCommand) -> None:
+        match command:
+            case Stop() | EmergencyStop():
+                raise RunEnd(RunState.INTERRUPTED, f"interrupted: {command.reason}")
+            case Pause() if self.state is RunState.RUNNING:
+                self._move(RunState.PAUSED)
+            case Resume() if self.state is RunState.PAUSED:
+                self._move(RunState.RUNNING)
+            case Button(pressed=pressed):
+                self.sim.press_button(pressed)
+            case Light(x=x, y=y, name=name):
+                movable = [light.name for light in self.sim.lights if light.movable]
+                try:
+                    if name is None and not movable:
+                        raise SimulationError("this world has no light that can be moved")
+                    self.sim.move_light(name if name is not None else movable[0], x, y)
+                except SimulationError as error:
+                    log.info("run %s: light not moved: %s", self.run_id, error)
+            case Goal(x=x, y=y, yaw=yaw):
+                self._publish_goal(x, y, yaw)
+            case Teleop(key=key, pressed=pressed):
+                teleop = self.builtins.get("teleop")
+                if teleop is None:
+                    log.info("run %s: a teleop key, but the run has no teleop node", self.run_id)
+                else:
+                    teleop.key(key, pressed)
+            case InjectFault(kind=kind, topic=topic, duration_s=duration_s):
+                self.faults.add(Fault(kind, topic, self.time_ns + round(duration_s * NS)))
+                if kind is FaultKind.STALL_MOTORS:
+                    self._stall_motors()
 
     def wait_while_paused(self, timeout_s: float) -> None:
         """Block up to `timeout_s` for a control while paused (the loop calls this)."""
         try:
-            action, value = self._controls.get(timeout=timeout_s)
+            command = self._controls.get(timeout=timeout_s)
         except queue.Empty:
             return
-        self._apply_control(action, value)
+        self._apply_command(command)

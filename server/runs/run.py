@@ -2,7 +2,7 @@
 
     run = Run(spec, launcher, out_dir, observer=hub)   # observer: optional, see RunObserver
     result = run.execute()          # blocking: call it from a worker thread or the CLI
-    run.stop() / run.pause() / run.press_button(True) / ...   # from any thread, meanwhile
+    run.command(Pause()) / run.command(Button(True)) / run.stop()   # any thread, meanwhile
 
 The loop itself lives in server/runs/clocks.py (lockstep and realtime); this module owns the
 lifecycle, the nodes, routing between them and the robot, controls, and the result. Nothing
@@ -533,8 +533,8 @@ class Run(RunControls, RunOutputs):
                 if event.kind is EventKind.LEFT_BOUNDS:
                     log.debug("run %s: robot left the bounds at %.3f s", self.run_id, event.time_s)
         while self._script and round(self._script[0][0] * NS) <= self.time_ns:
-            _, action, value = self._script.pop(0)
-            self._apply_control(action, value)
+            _, command = self._script.pop(0)
+            self._apply_command(command)
         if self.builtins:
             self.builtins.tick(self)
         if self._finishing_nodes():

@@ -19,12 +19,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from sandbox.protocol import Api, Clock
+from server.runs.commands import SCRIPTABLE, RunCommand
 from server.sim import load_world, robot_ids, robots_for_world, world_ids
 
 MAX_DURATION_S = 3600.0  # [s] an hour of simulated time: longer is a mistake, not an exercise
 MAX_NODES = 8  # a launch file larger than this is not a student exercise
 MAX_CODE_BYTES = 256 * 1024  # [bytes] per node file
-SCRIPT_ACTIONS = ("light", "goal", "button", "fault", "teleop")
 _NODE_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]{0,39}$")
 
 
@@ -79,8 +79,8 @@ class RunSpec:
     light_position: tuple[float, float] | None = None  # moves the world's first movable light
     goal: tuple[float, float, float] | None = None  # x [m], y [m], yaw [rad], on topic "goal"
     params: dict[str, object] = field(default_factory=dict)  # rospy.get_param values
-    # Scripted controls: (run time [s], action, value), e.g. (10.0, "light", ("lamp", 1.5, 1)).
-    script: tuple[tuple[float, str, object], ...] = ()
+    # Scripted commands: (run time [s], command), e.g. (10.0, Light(1.5, 1.0, name="lamp")).
+    script: tuple[tuple[float, RunCommand], ...] = ()
     builtin_nodes: tuple[str, ...] = ()  # trusted helpers: map_server, localization, ...
     # Workspace data files (relative path, bytes) copied into every node's working directory.
     files: tuple[tuple[str, bytes], ...] = ()
@@ -167,13 +167,14 @@ class RunSpec:
                     f"built-in node '{name}' serves ROS 2 nodes (rclpy) only, and this run's "
                     "nodes are ROS 1; write them with rclpy or leave the built-in out"
                 )
-        for time_s, action, _ in self.script:
-            if not (isinstance(time_s, (int, float)) and 0 <= time_s <= self.duration_s):
-                raise RunSpecError(f"scripted '{action}' at {time_s!r} s is outside the run")
-            if action not in SCRIPT_ACTIONS:
+        for time_s, command in self.script:
+            if not isinstance(command, SCRIPTABLE):
                 raise RunSpecError(
-                    f"scripted action '{action}' is unknown; use one of {', '.join(SCRIPT_ACTIONS)}"
+                    f"a script cannot send {command!r}; it sends one of "
+                    f"{', '.join(cls.op for cls in SCRIPTABLE)}"
                 )
+            if not (isinstance(time_s, (int, float)) and 0 <= time_s <= self.duration_s):
+                raise RunSpecError(f"scripted '{command.op}' at {time_s!r} s is outside the run")
         for label, values in (
             ("initial_pose", self.initial_pose),
             ("light_position", self.light_position),

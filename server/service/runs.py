@@ -24,6 +24,7 @@ from server.exercises.grading import judge_run, run_spec
 from server.hardware.backend import HardwareRobot
 from server.hardware.queue import QueueError
 from server.hardware.safety import MotionLimits
+from server.runs.commands import RunCommand, Stop
 from server.runs.recorder import json_safe
 from server.runs.result import RunResult
 from server.runs.run import Run
@@ -260,15 +261,13 @@ class RunService:
         link.drain()
         return HardwareRobot(kind, link, MotionLimits(**limits), watchdog_s)
 
-    def emergency_stop(self, run_id: str, who: str) -> bool:
-        """Stop a run now; on a real robot, zero velocity is sent from this thread at once."""
+    def command(self, run_id: str, command: RunCommand) -> bool:
+        """Send a command (server/runs/commands.py) to a running run; False when it is not
+        running (any more). Raises CommandError when the run's state refuses it now."""
         active = self._active.get(run_id)
         if active is None:
             return False
-        backend = active.run.backend
-        if backend is not None:
-            backend.stop()
-        active.run.stop(f"emergency stop by {who}")
+        active.run.command(command)
         return True
 
     # ------------------------------------------------------------------------------ running
@@ -340,17 +339,13 @@ class RunService:
 
     def stop(self, run_id: str, reason: str = "stopped by the user") -> bool:
         """Ask a run to stop; False when it is not running (any more)."""
-        active = self._active.get(run_id)
-        if active is None:
-            return False
-        active.run.stop(reason)
-        return True
+        return self.command(run_id, Stop(reason))
 
     def stop_user(self, user_id: str, reason: str) -> int:
         stopped = 0
         for active in self.active_runs():
             if active.user_id == user_id:
-                active.run.stop(reason)
+                active.run.command(Stop(reason))
                 stopped += 1
         return stopped
 
@@ -360,7 +355,7 @@ class RunService:
             self._closing = True
             actives = list(self._active.values())
         for active in actives:
-            active.run.stop("the server is shutting down")
+            active.run.command(Stop("the server is shutting down"))
         deadline = time.monotonic() + self.settings.shutdown_grace_s
         while self._active and time.monotonic() < deadline:
             time.sleep(0.05)

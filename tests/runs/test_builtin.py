@@ -7,6 +7,7 @@ import pytest
 
 from sandbox.protocol import Clock
 from server.runs.builtin import _grow, astar
+from server.runs.commands import CommandError, Teleop
 from server.runs.run import Run
 from server.runs.spec import NodeSpec, RunSpec, RunSpecError
 from server.runs.state import RunState
@@ -81,7 +82,7 @@ def test_teleop_drives_while_a_key_is_held(tmp_path, launcher):
         (NodeSpec("idle", "def step(obs):\n    return None\n", "idle.py"),),
         duration_s=3.0,
         builtin_nodes=("teleop",),
-        script=((0.5, "teleop", ("up", True)), (1.5, "teleop", ("up", False))),
+        script=((0.5, Teleop("up", True)), (1.5, Teleop("up", False))),
     )
     run = Run(spec, launcher, tmp_path / "run")
     start_x = 1.0  # light_arena's centre spawn, facing +x
@@ -89,5 +90,5 @@ def test_teleop_drives_while_a_key_is_held(tmp_path, launcher):
     assert result.state is RunState.FINISHED, result.reason
     moved = run.sim.state.pose.x - start_x
     assert moved == pytest.approx(0.1, abs=0.015)  # 1 s at 0.1 m/s, less the motor lag
-    with pytest.raises(ValueError, match="teleop knows the keys"):
-        run.teleop("jump", True)
+    with pytest.raises(CommandError, match="teleop knows the keys"):
+        Teleop("jump", True)

@@ -16,6 +16,7 @@ from mcap_ros2.decoder import DecoderFactory
 from sandbox.msgs import get_message_class
 from sandbox.protocol import Envelope, TopicDecl
 from server.runs.builtin import BUILTIN_NODES, BuiltinNode
+from server.runs.commands import Goal, InjectFault, Teleop
 from server.runs.faults import FaultKind
 from server.runs.run import Run
 from server.runs.spec import NodeSpec, RunSpec, RunSpecError
@@ -171,7 +172,7 @@ def test_the_zero_command_at_the_end_uses_the_type_the_node_used(tmp_path):
 def test_the_goal_is_a_ros2_pose_stamped(tmp_path):
     run = prepared(tmp_path)
     listen(run, "goal", "geometry_msgs/msg/PoseStamped")
-    run.set_goal(1.0, -0.5, math.pi / 2)
+    run.command(Goal(1.0, -0.5, math.pi / 2))
     run._apply_controls()
     [(_, kind, goal)] = received(run)
     assert kind == "geometry_msgs/msg/PoseStamped"
@@ -184,7 +185,7 @@ def test_the_goal_is_a_ros2_pose_stamped(tmp_path):
 def test_faults_act_on_the_converted_messages(tmp_path):
     run = prepared(tmp_path)
     listen(run, "Distance", "std_msgs/msg/Int32")
-    run.inject_fault(FaultKind.DROP_TOPIC, "Distance", 1.0)
+    run.command(InjectFault(FaultKind.DROP_TOPIC, "Distance", 1.0))
     run._apply_controls()
     run.advance_to(NS // 2)
     assert received(run) == []
@@ -217,7 +218,7 @@ def test_ros1_builtins_publish_ros2_and_take_a_nodes_ros2_goal(tmp_path):
     plan = [m for topic, _, m in messages if topic == "plan"][-1]
     assert plan._type == "nav_msgs/msg/Path" and len(plan.poses) >= 2
     # teleop's ROS 1 Twist drives the robot and is recorded as a ROS 2 Twist.
-    run.teleop("up", True)
+    run.command(Teleop("up", True))
     run._apply_controls()
     run.advance_to(NS)
     assert run.sim.read("cmd_vel").linear.x > 0

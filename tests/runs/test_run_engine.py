@@ -12,6 +12,7 @@ from mcap.reader import make_reader
 
 from sandbox.msgs.geometry_msgs import Twist
 from sandbox.protocol import Clock
+from server.runs.commands import Button, Goal, InjectFault, Pause, Resume
 from server.runs.faults import FaultKind
 from server.runs.run import Run
 from server.runs.spec import NodeSpec, RunSpec, RunSpecError
@@ -199,15 +200,15 @@ def step(obs):
     thread.start()
     while run.progress[0] < 1.0:
         time.sleep(0.01)
-    run.pause()
+    run.command(Pause())
     time.sleep(0.2)
     paused_at = run.progress[0]
     time.sleep(0.3)
     assert run.progress[0] == paused_at and run.state is RunState.PAUSED
-    run.press_button(True)
-    run.set_goal(1.2, 0.4)
-    run.inject_fault(FaultKind.DROP_TOPIC, "Distance", 1.0)
-    run.resume()
+    run.command(Button(True))
+    run.command(Goal(1.2, 0.4))
+    run.command(InjectFault(FaultKind.DROP_TOPIC, "Distance", 1.0))
+    run.command(Resume())
     time.sleep(0.3)
     run.stop("stopped by the test")
     thread.join(timeout=30)

@@ -29,7 +29,6 @@ import asyncio
 import contextlib
 import json
 import logging
-import math
 import time
 
 from fastapi import APIRouter, WebSocket, WebSocketDisconnect
@@ -37,6 +36,7 @@ from starlette.concurrency import run_in_threadpool
 
 from server.api.auth import foreign_origin, websocket_user
 from server.api.sockets import REVOKED_CODE, REVOKED_REASON
+from server.runs.commands import CommandError, parse_command
 from server.service.telemetry import SubscriptionError, UnknownRunError, ViewerLimitError
 from server.store import runs as run_store
 
@@ -49,18 +49,7 @@ MAX_COMMAND_CHARS = 4096  # a command is a small JSON object
 WAIT_S = 1.0  # [s] the writer wakes at least this often to notice a closed socket
 
 
-class CommandError(ValueError):
-    pass
-
-
-def _number(command: dict, key: str, default: float | None = None) -> float:
-    value = command.get(key, default)
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise CommandError(f"'{key}' must be a finite number, got {value!r}")
-    return float(value)
-
-
-def _apply(op: str, command: dict, viewer, active) -> None:
+def _apply(op: str, command: dict, viewer, service, run_id: str) -> None:
     """Do one command; raise CommandError with a sentence when it cannot be done."""
     if op == "subscribe":
         viewer.subscribe(command.get("topic"), command.get("max_rate_hz", 10))
@@ -68,40 +57,9 @@ def _apply(op: str, command: dict, viewer, active) -> None:
     if op == "unsubscribe":
         viewer.unsubscribe(command.get("topic"))
         return
-    if active is None:
+    run_command = parse_command(command)
+    if not service.command(run_id, run_command):
         raise CommandError(f"the run has ended; '{op}' needs a running run")
-    run = active.run
-    if op == "stop":
-        run.stop("stopped by the user")
-    elif op == "estop":
-        if run.backend is not None:
-            run.backend.stop()
-        run.stop("emergency stop by the user")
-    elif op == "pause":
-        run.pause()
-    elif op == "resume":
-        run.resume()
-    elif op == "button":
-        run.press_button(bool(command.get("pressed", True)))
-    elif op == "light":
-        name = command.get("name")
-        if name is None:
-            movable = [light.name for light in run.sim.lights if light.movable] if run.sim else []
-            if not movable:
-                raise CommandError("this world has no light that can be moved")
-            name = movable[0]
-        run.move_light(str(name), _number(command, "x"), _number(command, "y"))
-    elif op == "goal":
-        run.set_goal(_number(command, "x"), _number(command, "y"), _number(command, "yaw", 0.0))
-    elif op == "teleop":
-        if run.builtins.get("teleop") is None:
-            raise CommandError("this run takes no keyboard driving (its exercise has no teleop)")
-        run.teleop(str(command.get("key")), bool(command.get("pressed", True)))
-    else:
-        raise CommandError(
-            f"unknown op {op!r}; ops: subscribe, unsubscribe, stop, estop, pause, resume, "
-            "button, light, goal, teleop"
-        )
 
 
 @router.websocket("/api/runs/{run_id}/live")
@@ -182,7 +140,7 @@ async def live(websocket: WebSocket, run_id: str) -> None:
                 if not isinstance(request_id, str | int | None) or isinstance(request_id, bool):
                     request_id = None
                     raise CommandError("'id' must be a string or an integer")
-                _apply(str(command.get("op")), command, viewer, service.active(run_id))
+                _apply(str(command.get("op")), command, viewer, service, run_id)
             except (CommandError, SubscriptionError, ValueError, TypeError) as error:
                 await send({"type": "error", "id": request_id, "detail": str(error)})
             else:

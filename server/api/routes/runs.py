@@ -17,6 +17,7 @@ from fastapi.responses import FileResponse, PlainTextResponse
 from sandbox.protocol import Clock
 from server.api.auth import Caller, current_user
 from server.api.schemas import RunCommand, RunCreate
+from server.runs import commands
 from server.runs.export import csv_file_name, export_csv
 from server.runs.launch import LaunchPlan
 from server.runs.recorder import ARTIFACTS_DIR, LOGS_DIR, RECORDING_FILE
@@ -259,21 +260,16 @@ def one(run_id: str, request: Request, caller: Caller = Depends(current_user)) -
     return run_out(visible_run(request, caller, run_id), service_of(request), with_code=True)
 
 
-def _command(request: Request, caller: Caller, run_id: str, action: str, reason: str) -> dict:
+def _command(request: Request, caller: Caller, run_id: str, command: commands.RunCommand) -> dict:
     record = visible_run(request, caller, run_id)
-    active = service_of(request).active(record.id)
-    if active is None:
-        raise HTTPException(409, f"run {run_id} has ended ({record.state}); nothing to {action}")
     try:
-        if action == "stop":
-            active.run.stop(reason)
-        elif action == "pause":
-            active.run.pause()
-        else:
-            active.run.resume()
-    except ValueError as error:
+        running = service_of(request).command(record.id, command)
+    except commands.CommandError as error:
         raise HTTPException(409, str(error)) from None
-    return {"ok": True, "id": run_id, "action": action}
+    if not running:
+        what = "stop" if isinstance(command, commands.EmergencyStop) else command.op
+        raise HTTPException(409, f"run {run_id} has ended ({record.state}); nothing to {what}")
+    return {"ok": True, "id": run_id, "action": command.op}
 
 
 @router.post("/{run_id}/stop", summary="Stop a run (the robot is commanded to stop)")
@@ -285,26 +281,23 @@ def stop(
 ) -> dict:
     who = "an instructor" if caller.is_instructor else "the user"
     reason = f"stopped by {who}" + (f": {body.reason}" if body and body.reason else "")
-    return _command(request, caller, run_id, "stop", reason)
+    return _command(request, caller, run_id, commands.Stop(reason))
 
 
 @router.post("/{run_id}/estop", summary="Emergency stop: the robot stops now")
 def emergency_stop(run_id: str, request: Request, caller: Caller = Depends(current_user)) -> dict:
-    record = visible_run(request, caller, run_id)
     who = "an instructor" if caller.is_instructor else "the user"
-    if not service_of(request).emergency_stop(record.id, who):
-        raise HTTPException(409, f"run {run_id} has ended ({record.state}); nothing to stop")
-    return {"ok": True, "id": run_id, "action": "estop"}
+    return _command(request, caller, run_id, commands.EmergencyStop(who))
 
 
 @router.post("/{run_id}/pause", summary="Pause a lockstep run")
 def pause(run_id: str, request: Request, caller: Caller = Depends(current_user)) -> dict:
-    return _command(request, caller, run_id, "pause", "")
+    return _command(request, caller, run_id, commands.Pause())
 
 
 @router.post("/{run_id}/resume", summary="Resume a paused run")
 def resume(run_id: str, request: Request, caller: Caller = Depends(current_user)) -> dict:
-    return _command(request, caller, run_id, "resume", "")
+    return _command(request, caller, run_id, commands.Resume())
 
 
 def _run_file(record: RunRecord, relative: str) -> Path:
