@@ -64,6 +64,9 @@ class _Bench:
     bounds = NO_BOUNDS
     lights = ()
 
+    def in_bounds(self, x: float, y: float, margin_m: float = 0.0) -> bool:
+        return True  # a bench has no map edges we know
+
 
 class HardwareRobot:
     """Duck-types `server.sim.Simulation` for a Run (see the module docstring)."""
@@ -105,6 +108,10 @@ class HardwareRobot:
     @property
     def time_s(self) -> float:
         return self._time_s
+
+    @property
+    def tick_s(self) -> float:
+        return POLL_S  # [s] the run looks for the robot's messages this often
 
     def next_publication_s(self) -> float:
         return self._time_s + POLL_S

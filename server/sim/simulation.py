@@ -200,6 +200,11 @@ class Simulation:
         return self._now_ns / NS_PER_S
 
     @property
+    def tick_s(self) -> float:
+        """[s] one physics tick: the smallest step that moves the simulation on."""
+        return self._tick_s
+
+    @property
     def topics(self) -> tuple[TopicSpec, ...]:
         return tuple(self._topics.values())
 
@@ -256,6 +261,16 @@ class Simulation:
         old = lights[index]
         lights[index] = LightSource(old.name, float(x), float(y), old.z, old.intensity, True)
         self.lights = tuple(lights)
+
+    def stop(self) -> None:
+        """Zero velocity on every velocity (Twist) topic, from the next tick on."""
+        for spec in self.topics:
+            if spec.direction is Direction.SUBSCRIBE and spec.type_name == "geometry_msgs/Twist":
+                self.apply(spec.name, spec.msg_type())
+
+    def take_logs(self) -> list[str]:
+        """A simulated robot logs nothing of its own (a real one's firmware does)."""
+        return []
 
     def next_publication_s(self) -> float:
         """Simulated time [s] at which the next sensor message falls due."""

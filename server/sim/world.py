@@ -149,10 +149,13 @@ class World:
                 nearest = min(nearest, -inside)
         return nearest
 
-    def in_bounds(self, x: float, y: float) -> bool:
-        """Whether (x, y) [m] lies within `bounds` (edges included)."""
+    def in_bounds(self, x: float, y: float, margin_m: float = 0.0) -> bool:
+        """Whether (x, y) [m] lies within `bounds` grown by `margin_m` on every side (edges
+        included)."""
         min_x, min_y, max_x, max_y = self.bounds
-        return min_x <= x <= max_x and min_y <= y <= max_y
+        return (
+            min_x - margin_m <= x <= max_x + margin_m and min_y - margin_m <= y <= max_y + margin_m
+        )
 
 
 def rasterize(
