@@ -17,6 +17,7 @@ from server.runs.faults import FaultKind
 from server.runs.run import Run
 from server.runs.spec import NodeSpec, RunSpec, RunSpecError
 from server.runs.state import RunState
+from tests.waiting import wait_until
 
 STEP_APPROACH = """
 RATE_HZ = 10
@@ -185,39 +186,83 @@ def test_recording_has_every_declared_topic_with_its_schema(tmp_path, launcher):
     assert Twist.deserialize(last_command) == Twist()
 
 
-def test_controls_stop_pause_button_goal_and_faults(tmp_path, launcher):
-    code = """
-RATE_HZ = 20
-def step(obs):
-    if obs.Button is not None and obs.Button.data:
-        print("button at", round(obs.time, 2))
-    if obs.goal is not None:
-        print("goal", obs.goal.pose.position.x)
-    return None
+CONTROLLED = """
+import rospy
+from std_msgs.msg import Bool, Int32
+from geometry_msgs.msg import PoseStamped
+
+GAP_S = 0.2  # [s] four Distance periods (20 Hz): longer than any jitter, shorter than a fault
+last = [None]
+pressed = [False]
+
+def on_distance(msg):
+    now = rospy.get_time()
+    if last[0] is not None and now - last[0] > GAP_S:
+        print("distance gap", last[0], now)
+    last[0] = now
+
+def on_button(msg):
+    if msg.data and not pressed[0]:
+        print("button at", round(rospy.get_time(), 2))
+    pressed[0] = msg.data
+
+rospy.init_node("controlled")
+rospy.Subscriber("Distance", Int32, on_distance)
+rospy.Subscriber("Button", Bool, on_button)
+rospy.Subscriber("goal", PoseStamped, lambda m: print("goal", m.pose.position.x))
+rospy.spin()
 """
-    run = crowbot_run(tmp_path, launcher, node(code), duration_s=600.0)
+
+FAULT_S = 1.0  # [s] of run time that Distance is dropped
+SENSOR_PERIOD_S = 0.05  # [s] the CrowBot publishes Distance at 20 Hz
+
+
+def test_controls_stop_pause_button_goal_and_faults(tmp_path, launcher):
+    run = crowbot_run(tmp_path, launcher, node(CONTROLLED), duration_s=600.0)
     thread = threading.Thread(target=lambda: setattr(run, "result", run.execute()))
     thread.start()
-    while run.progress[0] < 1.0:
-        time.sleep(0.01)
-    run.command(Pause())
-    time.sleep(0.2)
-    paused_at = run.progress[0]
-    time.sleep(0.3)
-    assert run.progress[0] == paused_at and run.state is RunState.PAUSED
-    run.command(Button(True))
-    run.command(Goal(1.2, 0.4))
-    run.command(InjectFault(FaultKind.DROP_TOPIC, "Distance", 1.0))
-    run.command(Resume())
-    time.sleep(0.3)
-    run.stop("stopped by the test")
-    thread.join(timeout=30)
+    logs = run.slots["controller"].logs
+
+    def printed(prefix: str) -> list[str]:
+        return [line for line in list(logs) if line.startswith(prefix)]
+
+    try:
+        wait_until(lambda: run.progress[0] >= 1.0, 30, "the run reached 1 s of run time")
+        run.command(Pause())
+        wait_until(lambda: run.state is RunState.PAUSED, 10, "the run paused")
+        paused_at = run.progress[0]
+        # Behaviour under test, not a wait: a paused run's time stays still for a while.
+        time.sleep(0.3)
+        assert run.progress[0] == paused_at and run.state is RunState.PAUSED
+        run.command(Button(True))
+        run.command(Goal(1.2, 0.4))
+        run.command(InjectFault(FaultKind.DROP_TOPIC, "Distance", FAULT_S))
+        run.command(Resume())
+        gaps = wait_until(
+            lambda: printed("distance gap"), 30, "Distance reached the node again after the fault"
+        )
+        wait_until(
+            lambda: printed("button at") and printed("goal"),
+            10,
+            "the node saw the button and the goal",
+        )
+    finally:
+        run.stop("stopped by the test")
+        thread.join(timeout=30)
     result = run.result
     assert result.state is RunState.INTERRUPTED
     assert result.reason == "interrupted: stopped by the test"
-    logs = list(run.slots["controller"].logs)
-    assert any(line.startswith("button at") for line in logs)
-    assert "goal 1.2" in logs
+    assert printed("goal") == ["goal 1.2"]
+    (pressed,) = printed("button at")
+    assert float(pressed.split()[-1]) >= paused_at
+    # One gap, the fault's: Distance stopped at the pause and came back once the fault's run
+    # time was over, within one sensor period.
+    assert len(gaps) == 1, gaps
+    last_before, first_after = (float(t) for t in gaps[0].split()[2:])
+    tolerance_s = 1e-6  # run times are printed as floats
+    assert last_before <= paused_at + tolerance_s
+    assert first_after - last_before >= FAULT_S - tolerance_s
+    assert paused_at + FAULT_S - tolerance_s <= first_after <= paused_at + FAULT_S + SENSOR_PERIOD_S
 
 
 def test_a_failing_run_leaves_a_concurrent_run_alone(tmp_path, launcher):
