@@ -23,7 +23,7 @@ from server.api import app as api_app
 ROOT = Path(__file__).resolve().parent.parent
 # What web/ must ship: the two pages and the bundles they load (not src/ or node tooling).
 WEB_FILES = ("index.html", "admin.html", "static/student.js", "static/student.css",
-             "static/admin/main.js", "static/admin/admin.css")  # fmt: skip
+             "static/admin.js", "static/admin.css")  # fmt: skip
 
 
 def tracked(*paths: str) -> list[str]:

@@ -215,7 +215,7 @@ def assert_security_headers(answer: httpx.Response) -> None:
 
 def test_every_page_file_and_answer_carries_security_headers(guarded):
     student = guarded.student("headers")
-    for path in ("/", "/admin", "/static/student.js", "/static/admin/main.js", "/api/health",
+    for path in ("/", "/admin", "/static/student.js", "/static/admin.js", "/api/health",
                  "/api/session", "/api/nope", "/openapi.json"):  # fmt: skip
         answer = student.get(path)
         assert answer.status_code in (200, 404), (path, answer.status_code)

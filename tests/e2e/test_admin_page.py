@@ -1,7 +1,7 @@
-"""The instructor console (`/admin`, web/admin.html and web/static/admin/): served with its
-modules, every module's imports resolve, and in Chromium an instructor creates a user (the
-invite link shows once), watches a student's live run and stops it, and reads a course's grade
-book; a student is told the page is for instructors."""
+"""The instructor console (`/admin`, web/admin.html and its bundle web/static/admin.js, built from
+web/src/admin/): served with its bundles, every source module's imports resolve, and in Chromium
+an instructor creates a user (the invite link shows once), watches a student's live run and
+stops it, and reads a course's grade book; a student is told the page is for instructors."""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ import httpx
 from tests.api.conftest import STEP_CONTROLLER, LabServer, wait_for_end
 
 WEB = Path(__file__).resolve().parents[2] / "web"
-MODULES = WEB / "static" / "admin"
+SOURCES = WEB / "src"
 TEST_IDS = (
     "create-user-form",
     "create-user-submit",
@@ -22,7 +22,8 @@ TEST_IDS = (
     "runs-table",
     "grades-table",
 )
-IMPORT = re.compile(r"import\s*\{([^}]*)\}\s*from\s*\"\./([\w.-]+\.js)\"", re.S)
+BUNDLE_LINK = re.compile(r'(?:href|src)="(/static/[\w.-]+\.(js|css))\?v=[0-9a-f]+"')
+IMPORT = re.compile(r"import\s*\{([^}]*)\}\s*from\s*\"(\.\.?/[\w./-]+\.js)\"", re.S)
 EXPORT = re.compile(r"export\s+(?:async\s+)?(?:function|const|let|class)\s+([\w$]+)")
 
 
@@ -30,28 +31,30 @@ def exported_names(path: Path) -> set[str]:
     return set(EXPORT.findall(path.read_text("utf-8")))
 
 
-def test_console_page_and_modules_are_served(web_lab: LabServer) -> None:
+def test_console_page_and_bundles_are_served(web_lab: LabServer) -> None:
     with httpx.Client(base_url=web_lab.url) as client:
         page = client.get("/admin")
         assert page.status_code == 200
         assert page.headers["content-type"].startswith("text/html")
         for test_id in TEST_IDS:
             assert f'data-testid="{test_id}"' in page.text, test_id
-        for module in sorted(MODULES.glob("*")):
-            answer = client.get(f"/static/admin/{module.name}")
-            assert answer.status_code == 200, module.name
-            kind = "javascript" if module.suffix == ".js" else "css"
-            assert kind in answer.headers["content-type"], (module.name, answer.headers)
+        bundles = BUNDLE_LINK.findall(page.text)
+        assert sorted(path for path, _ in bundles) == ["/static/admin.css", "/static/admin.js"]
+        for path, suffix in bundles:
+            answer = client.get(path)
+            assert answer.status_code == 200, path
+            kind = "javascript" if suffix == "js" else "css"
+            assert kind in answer.headers["content-type"], (path, answer.headers)
 
 
-def test_every_module_import_names_an_export() -> None:
-    """A missing export breaks the whole page at load in the browser: catch it without one."""
-    modules = sorted(MODULES.glob("*.js"))
-    assert modules
+def test_every_source_import_names_an_export() -> None:
+    """A missing export fails the bundler; this finds it without Node, in every page's sources."""
+    modules = sorted(SOURCES.rglob("*.js"))
+    assert any(m.parent.name == "admin" for m in modules)
     for module in modules:
         for names, target in IMPORT.findall(module.read_text("utf-8")):
-            source = MODULES / target
-            assert source.is_file(), f"{module.name} imports ./{target}, which does not exist"
+            source = (module.parent / target).resolve()
+            assert source.is_file(), f"{module.name} imports {target}, which does not exist"
             available = exported_names(source)
             for name in (n.strip() for n in names.split(",")):
                 if name:

@@ -2,6 +2,8 @@
 // [1, 2]}) and as the CSV export writes them (columns "linear.x"; arrays as one JSON column).
 // A field is named by a path: "linear.x", "data[0]", "transforms[0].transform.translation.x".
 
+import { parseCsv } from "./csv.js";
+
 export const LONG_ARRAY = 16; // arrays longer than this are offered as one field with an index
 
 /**
@@ -60,40 +62,6 @@ export function csvFileName(topic) {
     .map((p) => p.replace(/[^\w.-]+/gu, "_"));
   const stem = parts.join("__").replace(/^\.+|\.+$/g, "");
   return `${stem || "topic"}.csv`;
-}
-
-/** Rows of a CSV text (RFC 4180: quoted fields, "" inside quotes). */
-export function parseCsv(text) {
-  const rows = [];
-  let row = [];
-  let field = "";
-  let quoted = false;
-  for (let i = 0; i < text.length; i++) {
-    const c = text[i];
-    if (quoted) {
-      if (c === '"') {
-        if (text[i + 1] === '"') {
-          field += '"';
-          i++;
-        } else quoted = false;
-      } else field += c;
-    } else if (c === '"') quoted = true;
-    else if (c === ",") {
-      row.push(field);
-      field = "";
-    } else if (c === "\n" || c === "\r") {
-      if (c === "\r" && text[i + 1] === "\n") i++;
-      row.push(field);
-      rows.push(row);
-      row = [];
-      field = "";
-    } else field += c;
-  }
-  if (field !== "" || row.length) {
-    row.push(field);
-    rows.push(row);
-  }
-  return rows;
 }
 
 function cell(text) {

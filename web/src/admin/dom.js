@@ -1,27 +1,11 @@
-// Small DOM helpers: elements built with textContent only (never innerHTML from data),
-// error lines next to their control, busy buttons, copying, dates.
+// The console's DOM helpers (elements themselves are built with common/dom.js's `h`, never
+// innerHTML from data): error lines next to their control, busy buttons, copying, dates,
+// durations, pickers, focus kept across a redraw.
+
+import { h } from "../common/dom.js";
 
 export const $ = (selector, root = document) => root.querySelector(selector);
 export const $$ = (selector, root = document) => [...root.querySelectorAll(selector)];
-
-/** h("button", {type: "button", onclick, dataset: {id}}, "Stop") */
-export function h(tag, attrs = {}, ...children) {
-  const el = document.createElement(tag);
-  for (const [key, value] of Object.entries(attrs || {})) {
-    if (value === undefined || value === null || value === false) continue;
-    if (key.startsWith("on") && typeof value === "function") el.addEventListener(key.slice(2), value);
-    else if (key === "dataset") Object.assign(el.dataset, value);
-    else if (key === "className") el.className = value;
-    else if (key === "text") el.textContent = value;
-    else if (value === true) el.setAttribute(key, "");
-    else el.setAttribute(key, String(value));
-  }
-  for (const child of children.flat()) {
-    if (child === undefined || child === null || child === false) continue;
-    el.append(child instanceof Node ? child : document.createTextNode(String(child)));
-  }
-  return el;
-}
 
 /** The error line of a form (its p.error), or the element itself when it is one. */
 function errorLine(target) {
@@ -54,7 +38,7 @@ export function clearError(target) {
 export function rowError(cell, error) {
   let line = cell.querySelector(".error");
   if (!line) {
-    line = h("span", { className: "error row-error", role: "alert" });
+    line = h("span", { class: "error row-error", role: "alert" });
     cell.append(line);
   }
   line.textContent = error instanceof Error ? error.message : String(error);
@@ -97,7 +81,7 @@ export async function copyText(text, button) {
     }
   }
   if (!ok) {
-    const area = h("textarea", { "aria-hidden": "true", className: "offscreen" });
+    const area = h("textarea", { "aria-hidden": "true", class: "offscreen" });
     area.value = text;
     document.body.append(area);
     area.select();
@@ -123,13 +107,14 @@ const dateTime = new Intl.DateTimeFormat(undefined, { dateStyle: "short", timeSt
 
 /** A <time> element for an ISO date, or a dash. */
 export function timeEl(iso) {
-  if (!iso) return h("span", { className: "muted" }, "–");
+  if (!iso) return h("span", { class: "muted" }, "–");
   const date = new Date(iso);
   if (Number.isNaN(date.getTime())) return h("span", {}, iso);
   return h("time", { datetime: iso, title: iso }, dateTime.format(date));
 }
 
-export function seconds(value) {
+/** A span of seconds as people say it: "8.5 s", "12 min 3 s", "5 h 2 min", "3 d 4 h". */
+export function duration(value) {
   if (value === null || value === undefined || Number.isNaN(Number(value))) return "–";
   const s = Number(value);
   if (s < 60) return `${s.toFixed(s < 10 ? 1 : 0)} s`;
@@ -154,7 +139,7 @@ export function setOptions(select, options, { keep = true, first = null } = {}) 
 }
 
 export function stateBadge(state) {
-  return h("span", { className: `state state-${state}` }, state);
+  return h("span", { class: `state state-${state}` }, state);
 }
 
 /** "<=" -> "≤", ">=" -> "≥" (the API's comparisons, shown as people write them). */

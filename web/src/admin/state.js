@@ -1,7 +1,7 @@
 // What several panels share: who is logged in, the users, exercises and courses. Each list is
 // loaded on demand and refreshed after a change; panels subscribe to redraw their pickers.
 
-import { get } from "./api.js";
+import { api } from "../common/api.js";
 
 export const state = {
   me: null,
@@ -30,13 +30,13 @@ function emit(kind) {
 }
 
 export async function loadUsers() {
-  state.users = (await get("/api/admin/users")).users;
+  state.users = (await api("/api/admin/users")).users;
   emit("users");
   return state.users;
 }
 
 export async function loadExercises() {
-  const answer = await get("/api/admin/exercises");
+  const answer = await api("/api/admin/exercises");
   state.exercises = answer.exercises;
   state.genericChecks = answer.generic_checks || [];
   emit("exercises");
@@ -44,13 +44,13 @@ export async function loadExercises() {
 }
 
 export async function loadCourses() {
-  state.courses = (await get("/api/admin/courses")).courses;
+  state.courses = (await api("/api/admin/courses")).courses;
   emit("courses");
   return state.courses;
 }
 
 export async function loadCatalog() {
-  const [robots, worlds] = await Promise.all([get("/api/robots"), get("/api/worlds")]);
+  const [robots, worlds] = await Promise.all([api("/api/robots"), api("/api/worlds")]);
   state.robots = robots;
   state.worlds = worlds;
 }

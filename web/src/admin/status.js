@@ -1,8 +1,9 @@
 // Server status: active runs, sandbox processes, CPU and memory, polled every 5 s while the page
 // is visible (a line in the header; cards on the Status section).
 
-import { get } from "./api.js";
-import { $, clearError, h, seconds, showError } from "./dom.js";
+import { api } from "../common/api.js";
+import { h } from "../common/dom.js";
+import { $, clearError, duration, showError } from "./dom.js";
 
 const POLL_MS = 5000;
 let timer = null;
@@ -11,10 +12,10 @@ let running = false;
 function card(title, value, ...lines) {
   return h(
     "div",
-    { className: "card" },
+    { class: "card" },
     h("h2", {}, title),
-    h("p", { className: "big" }, value),
-    ...lines.filter(Boolean).map((line) => h("p", { className: "muted small" }, line)),
+    h("p", { class: "big" }, value),
+    ...lines.filter(Boolean).map((line) => h("p", { class: "muted small" }, line)),
   );
 }
 
@@ -91,7 +92,7 @@ function render(s) {
     hardwareCard(s.hardware),
     card(
       "Server",
-      `up ${seconds(s.uptime_s)}`,
+      `up ${duration(s.uptime_s)}`,
       `database: ${s.database ?? "?"}`,
       s.queues ? `waiting runs: ${s.queues.waiting_runs}; ${s.queues.note || ""}` : null,
     ),
@@ -104,7 +105,7 @@ function render(s) {
 
 async function poll() {
   try {
-    const s = await get("/api/admin/status");
+    const s = await api("/api/admin/status");
     clearError($("#status-error"));
     render(s);
   } catch (error) {

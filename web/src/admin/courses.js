@@ -2,9 +2,10 @@
 // book of a course (or of every student), fetched as CSV, parsed and shown as a table, with
 // the CSV itself to download.
 
-import { ApiError, api, del, enc, get, post } from "./api.js";
-import { parseCsv } from "./csv.js";
-import { $, $$, busy, clearError, clearRowError, h, rowError, setOptions, showError, timeEl } from "./dom.js";
+import { ApiError, api } from "../common/api.js";
+import { parseCsv } from "../common/csv.js";
+import { h } from "../common/dom.js";
+import { $, $$, busy, clearError, clearRowError, rowError, setOptions, showError, timeEl } from "./dom.js";
 import { watchUrl } from "./runs.js";
 import { exerciseTitle, loadCourses, loadUsers, state, subscribe } from "./state.js";
 
@@ -28,7 +29,7 @@ function renderCourses() {
       "button",
       {
         type: "button",
-        className: "link",
+        class: "link",
         "aria-pressed": String(selected?.id === course.id),
         title: "show its students, exercises and grades",
       },
@@ -37,10 +38,10 @@ function renderCourses() {
     open.addEventListener("click", () => openCourse(course.id));
     return h(
       "tr",
-      { dataset: { courseId: course.id }, className: selected?.id === course.id ? "selected" : null },
+      { dataset: { courseId: course.id }, class: selected?.id === course.id ? "selected" : null },
       h("th", { scope: "row" }, open),
       h("td", {}, String(course.student_count ?? "")),
-      h("td", {}, course.exercises.length ? course.exercises.join(", ") : h("span", { className: "muted" }, "none")),
+      h("td", {}, course.exercises.length ? course.exercises.join(", ") : h("span", { class: "muted" }, "none")),
       h("td", {}, timeEl(course.created_at)),
     );
   });
@@ -56,7 +57,7 @@ function renderCourses() {
 async function openCourse(id, focus = true) {
   try {
     clearError($("#courses-error"));
-    selected = await get(`/api/admin/courses/${enc(id)}`);
+    selected = await api(`/api/admin/courses/${encodeURIComponent(id)}`);
   } catch (error) {
     showError($("#courses-error"), error);
     return;
@@ -88,14 +89,14 @@ function renderDetail() {
     ...course.exercises.map((id) => {
       const remove = h(
         "button",
-        { type: "button", className: "chip-x", "aria-label": `Take ${id} off the course` },
+        { type: "button", class: "chip-x", "aria-label": `Take ${id} off the course` },
         "×",
       );
-      const item = h("li", { className: "chip" }, h("span", { title: id }, exerciseTitle(id) || id), remove);
+      const item = h("li", { class: "chip" }, h("span", { title: id }, exerciseTitle(id) || id), remove);
       remove.addEventListener("click", () =>
         busy(remove, async () => {
           try {
-            await del(`/api/admin/courses/${enc(course.id)}/exercises/${enc(id)}`);
+            await api(`/api/admin/courses/${encodeURIComponent(course.id)}/exercises/${encodeURIComponent(id)}`, { method: "DELETE" });
             await refreshCourse();
             $("#course-add-ex").elements.exercise.focus();
           } catch (error) {
@@ -106,7 +107,7 @@ function renderDetail() {
       return item;
     }),
   );
-  if (!course.exercises.length) list.append(h("li", { className: "muted" }, "No exercise assigned yet."));
+  if (!course.exercises.length) list.append(h("li", { class: "muted" }, "No exercise assigned yet."));
   setOptions(
     $("#course-add-ex").elements.exercise,
     state.exercises.filter((e) => !e.error && !course.exercises.includes(e.id)).map((e) => [e.id, `${e.title} (${e.id})`]),
@@ -115,17 +116,17 @@ function renderDetail() {
   const students = course.students || [];
   $("#course-students tbody").replaceChildren(
     ...students.map((s) => {
-      const cell = h("td", { className: "row-actions" });
+      const cell = h("td", { class: "row-actions" });
       const remove = h(
         "button",
-        { type: "button", className: "secondary small-btn", "aria-label": `Unenrol ${s.name}` },
+        { type: "button", class: "secondary small-btn", "aria-label": `Unenrol ${s.name}` },
         "Unenrol",
       );
       remove.addEventListener("click", () =>
         busy(remove, async () => {
           clearRowError(cell);
           try {
-            await del(`/api/admin/courses/${enc(course.id)}/students/${enc(s.id)}`);
+            await api(`/api/admin/courses/${encodeURIComponent(course.id)}/students/${encodeURIComponent(s.id)}`, { method: "DELETE" });
             await refreshCourse();
             $("#h-course-students").focus();
           } catch (error) {
@@ -145,7 +146,7 @@ function renderDetail() {
     }),
   );
   if (!students.length) {
-    $("#course-students tbody").append(h("tr", {}, h("td", { colspan: 4, className: "muted" }, "No student enrolled yet.")));
+    $("#course-students tbody").append(h("tr", {}, h("td", { colspan: 4, class: "muted" }, "No student enrolled yet.")));
   }
   renderEnrolList();
 }
@@ -164,23 +165,23 @@ function renderEnrolList() {
     ...candidates.map((u) =>
       h(
         "label",
-        { className: "check" },
+        { class: "check" },
         h("input", { type: "checkbox", value: u.id, name: "student" }),
         ` ${u.name}`,
-        u.email ? h("span", { className: "muted" }, ` ${u.email}`) : null,
-        u.disabled ? h("span", { className: "muted" }, " (disabled)") : null,
+        u.email ? h("span", { class: "muted" }, ` ${u.email}`) : null,
+        u.disabled ? h("span", { class: "muted" }, " (disabled)") : null,
       ),
     ),
   );
   if (!candidates.length) {
-    list.append(h("p", { className: "muted small" }, filter ? "No student matches." : "Every student is enrolled. Add students on the Users page."));
+    list.append(h("p", { class: "muted small" }, filter ? "No student matches." : "Every student is enrolled. Add students on the Users page."));
   }
 }
 
 // ------------------------------------------------------------------------------ grades
 function updateExportLink() {
   const course = $("#grades-course").value;
-  $("#grades-export").href = `/api/admin/grades.csv${course ? `?course=${enc(course)}` : ""}`;
+  $("#grades-export").href = `/api/admin/grades.csv${course ? `?course=${encodeURIComponent(course)}` : ""}`;
 }
 
 function gradeCell(header, value) {
@@ -191,9 +192,9 @@ function gradeCell(header, value) {
     return h("td", {}, h("a", { href: value, target: "_blank", rel: "noopener" }, "JSON"));
   }
   if (header === "best_score") {
-    return h("td", { className: "num" }, value === "" ? h("span", { className: "muted" }, "–") : value);
+    return h("td", { class: "num" }, value === "" ? h("span", { class: "muted" }, "–") : value);
   }
-  if (header === "attempts") return h("td", { className: "num" }, value);
+  if (header === "attempts") return h("td", { class: "num" }, value);
   return h("td", {}, value);
 }
 
@@ -204,7 +205,7 @@ async function loadGrades() {
   let text;
   try {
     clearError($("#grades-error"));
-    text = await api("GET", `/api/admin/grades.csv${course ? `?course=${enc(course)}` : ""}`);
+    text = await api(`/api/admin/grades.csv${course ? `?course=${encodeURIComponent(course)}` : ""}`);
     if (typeof text !== "string") throw new ApiError(0, "the grade book did not come as CSV text");
   } catch (error) {
     showError($("#grades-error"), error);
@@ -234,7 +235,7 @@ export function initCourses() {
     await busy($("button[type=submit]", create), async () => {
       clearError(create);
       try {
-        const course = await post("/api/admin/courses", { name: create.elements.name.value });
+        const course = await api("/api/admin/courses", { method: "POST", body: { name: create.elements.name.value } });
         create.reset();
         await loadCourses();
         await openCourse(course.id);
@@ -256,7 +257,7 @@ export function initCourses() {
         return;
       }
       try {
-        await api("PUT", `/api/admin/courses/${enc(selected.id)}/exercises/${enc(exercise)}`);
+        await api(`/api/admin/courses/${encodeURIComponent(selected.id)}/exercises/${encodeURIComponent(exercise)}`, { method: "PUT" });
         await refreshCourse();
         loadGrades();
         assign.elements.exercise.focus();
@@ -283,7 +284,7 @@ export function initCourses() {
       }
       try {
         for (const id of ids) {
-          await api("PUT", `/api/admin/courses/${enc(selected.id)}/students/${enc(id)}`);
+          await api(`/api/admin/courses/${encodeURIComponent(selected.id)}/students/${encodeURIComponent(id)}`, { method: "PUT" });
         }
       } catch (error) {
         showError(enrol, error);
@@ -299,7 +300,7 @@ export function initCourses() {
     if (!window.confirm(`Delete the course '${selected.name}'? Its students and their runs stay.`)) return;
     await busy(event.currentTarget, async () => {
       try {
-        await del(`/api/admin/courses/${enc(selected.id)}`);
+        await api(`/api/admin/courses/${encodeURIComponent(selected.id)}`, { method: "DELETE" });
         selected = null;
         $("#course-detail").hidden = true;
         $("#grades-course").value = "";

@@ -1,9 +1,10 @@
 // Users: the list (filter), one created, many imported from CSV, disable/enable, a new token.
 // An invite link exists only in the answer that made its token: it is shown once, to copy.
 
-import { api, enc, post } from "./api.js";
-import { toCsv } from "./csv.js";
-import { $, busy, clearError, clearRowError, copyText, h, keepFocus, rowError, showError, timeEl } from "./dom.js";
+import { api } from "../common/api.js";
+import { toCsv } from "../common/csv.js";
+import { h } from "../common/dom.js";
+import { $, busy, clearError, clearRowError, copyText, keepFocus, rowError, showError, timeEl } from "./dom.js";
 import { loadUsers, state, subscribe } from "./state.js";
 
 let lastBulk = [];
@@ -35,10 +36,10 @@ function showBulkInvites(users) {
           {},
           h(
             "div",
-            { className: "copy-row" },
-            h("label", { className: "sr-only", for: id }, `Invite link of ${u.name}`),
-            h("input", { id, readonly: true, value: u.invite_url, className: "link-input" }),
-            h("button", { type: "button", className: "copy secondary small-btn", "data-copy": `#${id}`, "aria-label": `Copy the invite link of ${u.name}` }, "Copy"),
+            { class: "copy-row" },
+            h("label", { class: "sr-only", for: id }, `Invite link of ${u.name}`),
+            h("input", { id, readonly: true, value: u.invite_url, class: "link-input" }),
+            h("button", { type: "button", class: "copy secondary small-btn", "data-copy": `#${id}`, "aria-label": `Copy the invite link of ${u.name}` }, "Copy"),
           ),
         ),
       );
@@ -53,13 +54,13 @@ function bulkCsv() {
 }
 
 function actionsFor(user) {
-  const cell = h("td", { className: "row-actions" });
+  const cell = h("td", { class: "row-actions" });
   const self = state.me && state.me.id === user.id;
   const toggle = h(
     "button",
     {
       type: "button",
-      className: user.disabled ? "secondary small-btn" : "danger small-btn",
+      class: user.disabled ? "secondary small-btn" : "danger small-btn",
       "data-testid": user.disabled ? "user-enable" : "user-disable",
       dataset: { action: "toggle" },
       "aria-label": `${user.disabled ? "Enable" : "Disable"} ${user.name}`,
@@ -71,7 +72,7 @@ function actionsFor(user) {
     busy(toggle, async () => {
       clearRowError(cell);
       try {
-        await api("PATCH", `/api/admin/users/${enc(user.id)}`, { json: { disabled: !user.disabled } });
+        await api(`/api/admin/users/${encodeURIComponent(user.id)}`, { method: "PATCH", body: { disabled: !user.disabled } });
         await loadUsers();
       } catch (error) {
         rowError(cell, error);
@@ -82,7 +83,7 @@ function actionsFor(user) {
     "button",
     {
       type: "button",
-      className: "secondary small-btn",
+      class: "secondary small-btn",
       "data-testid": "user-new-token",
       dataset: { action: "token" },
       "aria-label": `New token for ${user.name}`,
@@ -94,7 +95,7 @@ function actionsFor(user) {
     busy(renew, async () => {
       clearRowError(cell);
       try {
-        const answer = await post(`/api/admin/users/${enc(user.id)}/token`);
+        const answer = await api(`/api/admin/users/${encodeURIComponent(user.id)}/token`, { method: "POST" });
         showInvite(answer);
         loadUsers();
       } catch (error) {
@@ -114,11 +115,11 @@ function renderUsers() {
   const rows = shown.map((u) =>
     h(
       "tr",
-      { dataset: { userId: u.id, key: u.id }, className: u.disabled ? "disabled" : null },
-      h("th", { scope: "row" }, u.name, state.me && state.me.id === u.id ? h("span", { className: "muted" }, " (you)") : null),
-      h("td", {}, u.email || h("span", { className: "muted" }, "–")),
+      { dataset: { userId: u.id, key: u.id }, class: u.disabled ? "disabled" : null },
+      h("th", { scope: "row" }, u.name, state.me && state.me.id === u.id ? h("span", { class: "muted" }, " (you)") : null),
+      h("td", {}, u.email || h("span", { class: "muted" }, "–")),
       h("td", {}, u.role),
-      h("td", {}, u.disabled ? h("span", { className: "state state-failed" }, "disabled") : "active"),
+      h("td", {}, u.disabled ? h("span", { class: "state state-failed" }, "disabled") : "active"),
       h("td", {}, timeEl(u.created_at)),
       h("td", {}, timeEl(u.token_created_at)),
       actionsFor(u),
@@ -147,7 +148,7 @@ export function initUsers() {
       if (email) body.email = email;
       if (data.get("course")) body.course = data.get("course");
       try {
-        const user = await post("/api/admin/users", body);
+        const user = await api("/api/admin/users", { method: "POST", body });
         form.reset();
         showInvite(user);
         await loadUsers();
@@ -179,9 +180,9 @@ export function initUsers() {
         return;
       }
       const course = bulk.elements.course.value;
-      const path = `/api/admin/users/bulk${course ? `?course=${enc(course)}` : ""}`;
+      const path = `/api/admin/users/bulk${course ? `?course=${encodeURIComponent(course)}` : ""}`;
       try {
-        const answer = await api("POST", path, { body: text, type: "text/csv" });
+        const answer = await api(path, { method: "POST", body: text, contentType: "text/csv" });
         bulk.reset();
         showBulkInvites(answer.users);
         await loadUsers();

@@ -3,17 +3,17 @@
 // recent runs with filters and paging. Watch opens the student page on the run; 3D opens the
 // viser view.
 
-import { enc, get, post } from "./api.js";
+import { api } from "../common/api.js";
+import { h } from "../common/dom.js";
 import {
   $,
   busy,
   clearError,
   clearRowError,
   cmp,
-  h,
+  duration,
   keepFocus,
   rowError,
-  seconds,
   setOptions,
   shortId,
   showError,
@@ -37,8 +37,8 @@ let recentTotal = 0;
 let recentRuns = [];
 let firstLive = true; // the first poll after showing the section: nothing has changed yet
 
-export const watchUrl = (id) => `/?run=${enc(id)}`;
-export const vizUrl = (id) => `/api/runs/${enc(id)}/viz/`;
+export const watchUrl = (id) => `/?run=${encodeURIComponent(id)}`;
+export const vizUrl = (id) => `/api/runs/${encodeURIComponent(id)}/viz/`;
 
 function who(run) {
   const name = userName(run.user_id);
@@ -47,7 +47,7 @@ function who(run) {
 
 function what(run) {
   const place = `${run.robot} in ${run.world}`;
-  const bench = run.hardware ? h("span", { className: "hw-badge", title: "a run on a real robot of the bench" }, `real robot ${run.hardware}`) : null;
+  const bench = run.hardware ? h("span", { class: "hw-badge", title: "a run on a real robot of the bench" }, `real robot ${run.hardware}`) : null;
   if (!run.exercise) return h("span", {}, place, bench ? [" ", bench] : null);
   const title = exerciseTitle(run.exercise);
   return h(
@@ -55,7 +55,7 @@ function what(run) {
     {},
     h("span", { title: run.exercise }, title || run.exercise),
     h("br"),
-    h("span", { className: "muted small" }, run.hardware ? run.robot : place),
+    h("span", { class: "muted small" }, run.hardware ? run.robot : place),
     bench ? [" ", bench] : null,
   );
 }
@@ -81,7 +81,7 @@ function stopButton(run, cell, after) {
     "button",
     {
       type: "button",
-      className: "danger small-btn",
+      class: "danger small-btn",
       "data-testid": "run-stop",
       dataset: { runId: run.id, action: "stop" },
       "aria-label": `Stop run ${shortId(run.id)}`,
@@ -93,7 +93,7 @@ function stopButton(run, cell, after) {
     busy(button, async () => {
       clearRowError(cell);
       try {
-        await post(`/api/admin/runs/${enc(run.id)}/stop`);
+        await api(`/api/admin/runs/${encodeURIComponent(run.id)}/stop`, { method: "POST" });
         button.dataset.done = "1"; // stays focusable (and aria-disabled) until its row goes
         button.textContent = "Stopping…";
         after?.();
@@ -110,7 +110,7 @@ function estopButton(run, cell, after) {
     "button",
     {
       type: "button",
-      className: "estop small-btn",
+      class: "estop small-btn",
       "data-testid": "run-estop",
       dataset: { runId: run.id, action: "estop" },
       "aria-label": `Emergency stop of run ${shortId(run.id)}${run.hardware ? ` on ${run.hardware}` : ""}`,
@@ -123,7 +123,7 @@ function estopButton(run, cell, after) {
     busy(button, async () => {
       clearRowError(cell);
       try {
-        await post(`/api/runs/${enc(run.id)}/estop`);
+        await api(`/api/runs/${encodeURIComponent(run.id)}/estop`, { method: "POST" });
         button.dataset.done = "1"; // stays focusable (and aria-disabled) until its row goes
         button.textContent = "Stopped";
         after?.();
@@ -139,17 +139,17 @@ function progress(run) {
   const time = Number(run.time_s) || 0;
   const total = Number(run.duration_s) || 0;
   const bar = h("progress", { max: total || 1, value: Math.min(time, total || 1), "aria-label": "robot time" });
-  return [bar, " ", h("span", { className: "small" }, `${seconds(time)} of ${seconds(total)}`)];
+  return [bar, " ", h("span", { class: "small" }, `${duration(time)} of ${duration(total)}`)];
 }
 
 // ------------------------------------------------------------------------------ live
 function liveRow(run) {
-  const actions = h("td", { className: "row-actions" });
+  const actions = h("td", { class: "row-actions" });
   const cells = {
     who: h("td", {}, who(run)),
     what: h("td", {}, what(run)),
     state: h("td", {}, stateBadge(run.state)),
-    time: h("td", { className: "nowrap" }, progress(run)),
+    time: h("td", { class: "nowrap" }, progress(run)),
     actions,
   };
   actions.append(...links(run), " ", stopButton(run, actions, pollLive), " ", estopButton(run, actions, pollLive));
@@ -183,7 +183,7 @@ function renderLive(runs) {
       if (entry.run.state !== run.state) entry.cells.state.replaceChildren(stateBadge(run.state));
       const bar = entry.cells.time.querySelector("progress");
       bar.value = Math.min(Number(run.time_s) || 0, Number(run.duration_s) || 1);
-      entry.cells.time.querySelector("span").textContent = `${seconds(run.time_s)} of ${seconds(run.duration_s)}`;
+      entry.cells.time.querySelector("span").textContent = `${duration(run.time_s)} of ${duration(run.duration_s)}`;
       entry.run = run;
     }
   }
@@ -215,7 +215,7 @@ function renderLive(runs) {
 async function pollLive() {
   try {
     const answers = await Promise.all(
-      LIVE_STATES.map((s) => get(`/api/admin/runs?state=${s}&limit=500`)),
+      LIVE_STATES.map((s) => api(`/api/admin/runs?state=${s}&limit=500`)),
     );
     clearError($("#live-error"));
     renderLive(answers.flatMap((a) => a.runs));
@@ -236,7 +236,7 @@ function schedule() {
 
 // ------------------------------------------------------------------------------ recent
 function scoreCell(run) {
-  if (run.score === null || run.score === undefined) return h("td", { className: "muted" }, "–");
+  if (run.score === null || run.score === undefined) return h("td", { class: "muted" }, "–");
   const checks = run.checks || [];
   const passed = checks.filter((c) => c.passed).length;
   const title = checks
@@ -246,15 +246,15 @@ function scoreCell(run) {
     "td",
     { title },
     `${Math.round(run.score * 100)} %`,
-    checks.length ? h("span", { className: "muted small" }, ` ${passed}/${checks.length} checks`) : null,
+    checks.length ? h("span", { class: "muted small" }, ` ${passed}/${checks.length} checks`) : null,
   );
 }
 
 function recentRow(run) {
   // data-key: a redraw puts focus back on the same control of the same run (keepFocus)
-  const actions = h("td", { className: "row-actions" }, ...links(run));
+  const actions = h("td", { class: "row-actions" }, ...links(run));
   if (!ACTIVE.has(run.state)) {
-    actions.append(" ", h("a", { href: `/api/runs/${enc(run.id)}/recording.mcap`, download: true }, "Recording"));
+    actions.append(" ", h("a", { href: `/api/runs/${encodeURIComponent(run.id)}/recording.mcap`, download: true }, "Recording"));
   } else {
     actions.append(" ", stopButton(run, actions, loadRecent));
   }
@@ -264,7 +264,7 @@ function recentRow(run) {
     h("th", { scope: "row" }, h("code", { title: run.id }, shortId(run.id))),
     h("td", {}, who(run)),
     h("td", {}, what(run)),
-    h("td", {}, stateBadge(run.state), run.reason ? h("div", { className: "muted small reason" }, run.reason) : null),
+    h("td", {}, stateBadge(run.state), run.reason ? h("div", { class: "muted small reason" }, run.reason) : null),
     scoreCell(run),
     h("td", {}, timeEl(run.created_at)),
     actions,
@@ -279,7 +279,7 @@ async function loadRecent() {
     if (value) params.set(key, value);
   }
   try {
-    const answer = await get(`/api/admin/runs?${params}`);
+    const answer = await api(`/api/admin/runs?${params}`);
     clearError($("#recent-error"));
     recentTotal = answer.total;
     recentRuns = answer.runs;

@@ -3,8 +3,9 @@
 // from scratch (robot, world, clock, seeds, starter code, generic checks); custom ones deleted;
 // any one tried (the reference solution of a built-in, the starter code of a custom one).
 
-import { ApiError, del, enc, post, put } from "./api.js";
-import { $, $$, busy, clearError, clearRowError, cmp, h, rowError, setOptions, shortId, showError } from "./dom.js";
+import { ApiError, api } from "../common/api.js";
+import { h } from "../common/dom.js";
+import { $, $$, busy, clearError, clearRowError, cmp, rowError, setOptions, shortId, showError } from "./dom.js";
 import { vizUrl, watchUrl } from "./runs.js";
 import { loadCatalog, loadExercises, state, subscribe } from "./state.js";
 
@@ -26,10 +27,10 @@ const builtin = (id) => state.exercises.find((e) => e.id === id && !e.custom);
 
 // ------------------------------------------------------------------------------ list
 function checkList(checks) {
-  if (!checks || !checks.length) return h("span", { className: "muted" }, "–");
+  if (!checks || !checks.length) return h("span", { class: "muted" }, "–");
   return h(
     "ul",
-    { className: "plain small" },
+    { class: "plain small" },
     checks.map((c) => h("li", {}, `${c.name} ${cmp(c.comparison)} ${c.threshold}${c.unit ? ` ${c.unit}` : ""}`)),
   );
 }
@@ -41,7 +42,7 @@ function tryButton(exercise, cell) {
     "button",
     {
       type: "button",
-      className: "small-btn",
+      class: "small-btn",
       "data-testid": "exercise-try",
       "aria-label": `${label} of ${exercise.id}`,
       title: `run the ${what} as yourself, and watch it`,
@@ -53,11 +54,11 @@ function tryButton(exercise, cell) {
       clearRowError(cell);
       cell.querySelector(".tried")?.remove();
       try {
-        const run = await post(`/api/admin/exercises/${enc(exercise.id)}/try`);
+        const run = await api(`/api/admin/exercises/${encodeURIComponent(exercise.id)}/try`, { method: "POST" });
         cell.append(
           h(
             "div",
-            { className: "tried small", role: "status", "data-testid": "exercise-try-result" },
+            { class: "tried small", role: "status", "data-testid": "exercise-try-result" },
             `Run ${shortId(run.id)} started (${run.tried}): `,
             h("a", { href: watchUrl(run.id), target: "_blank", rel: "noopener" }, "Watch"),
             " · ",
@@ -73,56 +74,56 @@ function tryButton(exercise, cell) {
 }
 
 function exerciseRow(exercise) {
-  const cell = h("td", { className: "row-actions" });
+  const cell = h("td", { class: "row-actions" });
   if (exercise.error) {
     // A stored definition that no longer builds: shown with its reason, to edit or delete.
     cell.append(deleteButton(exercise, cell));
     return h(
       "tr",
-      { dataset: { exerciseId: exercise.id }, className: "broken" },
-      h("th", { scope: "row" }, exercise.title || exercise.id, h("br"), h("code", { className: "small" }, exercise.id)),
-      h("td", { colspan: 3 }, h("span", { className: "error" }, exercise.error)),
+      { dataset: { exerciseId: exercise.id }, class: "broken" },
+      h("th", { scope: "row" }, exercise.title || exercise.id, h("br"), h("code", { class: "small" }, exercise.id)),
+      h("td", { colspan: 3 }, h("span", { class: "error" }, exercise.error)),
       h("td", {}, "custom (broken)"),
       cell,
     );
   }
   cell.append(tryButton(exercise, cell), " ");
   if (exercise.custom) {
-    const edit = h("button", { type: "button", className: "secondary small-btn", "aria-label": `Edit ${exercise.id}` }, "Edit");
+    const edit = h("button", { type: "button", class: "secondary small-btn", "aria-label": `Edit ${exercise.id}` }, "Edit");
     edit.addEventListener("click", () => openForm(exercise));
     cell.append(edit, " ", deleteButton(exercise, cell));
   } else {
     const copy = h(
       "button",
-      { type: "button", className: "secondary small-btn", "aria-label": `Customise ${exercise.id}`, title: "a new custom exercise from this one" },
+      { type: "button", class: "secondary small-btn", "aria-label": `Customise ${exercise.id}`, title: "a new custom exercise from this one" },
       "Customise",
     );
     copy.addEventListener("click", () => openForm(null, exercise.id));
     cell.append(copy);
   }
-  const title = h("th", { scope: "row" }, exercise.title, h("br"), h("code", { className: "small" }, exercise.id));
-  const more = h("details", { className: "small" }, h("summary", {}, "Details"));
-  if (exercise.description) more.append(h("p", { className: "description" }, exercise.description));
-  if (exercise.source) more.append(h("p", { className: "muted" }, `Source: ${exercise.source}`));
-  if (exercise.seeds) more.append(h("p", { className: "muted" }, `Seeds: ${exercise.seeds.join(", ")}; clock: ${exercise.clock}`));
+  const title = h("th", { scope: "row" }, exercise.title, h("br"), h("code", { class: "small" }, exercise.id));
+  const more = h("details", { class: "small" }, h("summary", {}, "Details"));
+  if (exercise.description) more.append(h("p", { class: "description" }, exercise.description));
+  if (exercise.source) more.append(h("p", { class: "muted" }, `Source: ${exercise.source}`));
+  if (exercise.seeds) more.append(h("p", { class: "muted" }, `Seeds: ${exercise.seeds.join(", ")}; clock: ${exercise.clock}`));
   for (const file of exercise.reference || []) {
-    more.append(h("p", {}, `Reference solution, node ${file.name} (${file.filename}):`), h("pre", { className: "code" }, file.code));
+    more.append(h("p", {}, `Reference solution, node ${file.name} (${file.filename}):`), h("pre", { class: "code" }, file.code));
   }
   for (const file of exercise.starter || []) {
-    more.append(h("p", {}, `Starter code, node ${file.name}:`), h("pre", { className: "code" }, file.code));
+    more.append(h("p", {}, `Starter code, node ${file.name}:`), h("pre", { class: "code" }, file.code));
   }
   title.append(more);
   const kind = exercise.custom
-    ? h("span", {}, "custom", exercise.template ? h("span", { className: "muted small" }, h("br"), `from ${exercise.template}`) : null)
+    ? h("span", {}, "custom", exercise.template ? h("span", { class: "muted small" }, h("br"), `from ${exercise.template}`) : null)
     : "built-in";
   return h(
     "tr",
     { dataset: { exerciseId: exercise.id } },
     title,
     h("td", {}, `${exercise.robot} in ${exercise.world}`),
-    h("td", { className: "nowrap" }, `${exercise.duration_s} s`),
+    h("td", { class: "nowrap" }, `${exercise.duration_s} s`),
     h("td", {}, checkList(exercise.checks)),
-    h("td", { className: "nowrap" }, kind),
+    h("td", { class: "nowrap" }, kind),
     cell,
   );
 }
@@ -130,7 +131,7 @@ function exerciseRow(exercise) {
 function deleteButton(exercise, cell) {
   const button = h(
     "button",
-    { type: "button", className: "danger small-btn", "data-testid": "exercise-delete", "aria-label": `Delete ${exercise.id}` },
+    { type: "button", class: "danger small-btn", "data-testid": "exercise-delete", "aria-label": `Delete ${exercise.id}` },
     "Delete",
   );
   button.addEventListener("click", () => {
@@ -138,7 +139,7 @@ function deleteButton(exercise, cell) {
     busy(button, async () => {
       clearRowError(cell);
       try {
-        await del(`/api/admin/exercises/${enc(exercise.id)}`);
+        await api(`/api/admin/exercises/${encodeURIComponent(exercise.id)}`, { method: "DELETE" });
         if (form().dataset.editing === exercise.id) closeForm();
         await loadExercises();
         $("#h-ex-list").focus();
@@ -173,14 +174,14 @@ function nodeEditor(name = "", code = "") {
   const index = $$(".node", $("#ex-nodes")).length;
   const nameId = `ex-node-name-${Date.now()}-${index}`;
   const codeId = `${nameId}-code`;
-  const remove = h("button", { type: "button", className: "secondary small-btn" }, "Remove node");
+  const remove = h("button", { type: "button", class: "secondary small-btn" }, "Remove node");
   const box = h(
     "div",
-    { className: "node" },
+    { class: "node" },
     h("label", { for: nameId }, "Node name"),
-    h("input", { id: nameId, className: "node-name", value: name, maxlength: 40, pattern: "[A-Za-z][A-Za-z0-9_]{0,39}", spellcheck: "false", autocomplete: "off" }),
+    h("input", { id: nameId, class: "node-name", value: name, maxlength: 40, pattern: "[A-Za-z][A-Za-z0-9_]{0,39}", spellcheck: "false", autocomplete: "off" }),
     h("label", { for: codeId }, "Python code"),
-    h("textarea", { id: codeId, className: "node-code code", rows: 12, spellcheck: "false" }),
+    h("textarea", { id: codeId, class: "node-code code", rows: 12, spellcheck: "false" }),
     remove,
   );
   $("textarea", box).value = code;
@@ -214,16 +215,16 @@ function checkRow(check, ticked, threshold) {
   return h(
     "tr",
     { dataset: { check: check.name } },
-    h("td", {}, h("input", { type: "checkbox", id, className: "check-use", checked: ticked, "aria-label": `use ${check.name}` })),
-    h("td", {}, h("label", { for: id }, h("code", {}, check.name)), h("div", { className: "muted small" }, check.description || "")),
-    h("td", { className: "nowrap" }, `value ${cmp(check.comparison)} threshold${unit ? ` [${unit.trim()}]` : ""}`),
+    h("td", {}, h("input", { type: "checkbox", id, class: "check-use", checked: ticked, "aria-label": `use ${check.name}` })),
+    h("td", {}, h("label", { for: id }, h("code", {}, check.name)), h("div", { class: "muted small" }, check.description || "")),
+    h("td", { class: "nowrap" }, `value ${cmp(check.comparison)} threshold${unit ? ` [${unit.trim()}]` : ""}`),
     h(
       "td",
       {},
       h("input", {
         type: "number",
         step: "any",
-        className: "check-threshold",
+        class: "check-threshold",
         value: threshold ?? "",
         "aria-label": `threshold of ${check.name}${unit}`,
       }),
@@ -405,11 +406,11 @@ async function submit(event) {
     try {
       let saved;
       if (editing) {
-        saved = await put(`/api/admin/exercises/${enc(editing)}`, payload);
+        saved = await api(`/api/admin/exercises/${encodeURIComponent(editing)}`, { method: "PUT", body: payload });
       } else {
         const id = f.elements.id.value.trim();
         if (!id) throw new ApiError(0, "give the exercise an id: lower case, digits and _, 3 to 64 characters");
-        saved = await post("/api/admin/exercises", { id, ...payload });
+        saved = await api("/api/admin/exercises", { method: "POST", body: { id, ...payload } });
       }
       closeForm();
       await loadExercises();

@@ -4,8 +4,9 @@
 // port and problems (GET /api/admin/status "hardware"). Polled every 2 s while the section is
 // shown; rows are redrawn with keepFocus, so keyboard focus stays on the same control.
 
-import { del, enc, get, patch, post } from "./api.js";
-import { $, busy, clearError, clearRowError, h, keepFocus, rowError, seconds, shortId, showError } from "./dom.js";
+import { api } from "../common/api.js";
+import { h } from "../common/dom.js";
+import { $, busy, clearError, clearRowError, duration, keepFocus, rowError, shortId, showError } from "./dom.js";
 import { subscribe, userName } from "./state.js";
 
 const POLL_MS = 2000;
@@ -28,12 +29,12 @@ function who(userId) {
 function connectionCell(robot) {
   const text = robot.connection || "not connected";
   const cls = text === "connected" ? "conn-ok" : text.startsWith("connected") ? "conn-warn" : "conn-off";
-  return h("td", { className: "reason" }, h("span", { className: `conn ${cls}` }, text));
+  return h("td", { class: "reason" }, h("span", { class: `conn ${cls}` }, text));
 }
 
 // ------------------------------------------------------------------------------ robots
 function robotRow(robot) {
-  const actions = h("td", { className: "row-actions" });
+  const actions = h("td", { class: "row-actions" });
   const service = h("input", {
     type: "checkbox",
     id: `service-${robot.name}`,
@@ -44,12 +45,12 @@ function robotRow(robot) {
   const serviceCell = h(
     "td",
     {},
-    h("label", { className: "check", for: service.id }, service, h("span", {}, robot.in_service ? "in service" : "out of service")),
+    h("label", { class: "check", for: service.id }, service, h("span", {}, robot.in_service ? "in service" : "out of service")),
   );
   service.addEventListener("change", async () => {
     clearRowError(serviceCell);
     try {
-      await patch(`/api/admin/robots/${enc(robot.name)}`, { in_service: service.checked });
+      await api(`/api/admin/robots/${encodeURIComponent(robot.name)}`, { method: "PATCH", body: { in_service: service.checked } });
       await poll();
     } catch (error) {
       service.checked = !service.checked;
@@ -60,7 +61,7 @@ function robotRow(robot) {
     "button",
     {
       type: "button",
-      className: "danger small-btn",
+      class: "danger small-btn",
       "data-testid": "robot-remove",
       dataset: { action: "remove" },
       "aria-label": `Remove ${robot.name}`,
@@ -72,7 +73,7 @@ function robotRow(robot) {
     busy(remove, async () => {
       clearRowError(actions);
       try {
-        await del(`/api/admin/robots/${enc(robot.name)}`);
+        await api(`/api/admin/robots/${encodeURIComponent(robot.name)}`, { method: "DELETE" });
         $("#h-robots").focus();
         await poll();
       } catch (error) {
@@ -85,10 +86,10 @@ function robotRow(robot) {
   const address = robot.baud ? `${robot.address} at ${robot.baud} baud` : robot.address;
   return h(
     "tr",
-    { dataset: { key: robot.name, name: robot.name }, className: robot.in_service ? "" : "disabled" },
+    { dataset: { key: robot.name, name: robot.name }, class: robot.in_service ? "" : "disabled" },
     h("th", { scope: "row" }, h("code", {}, robot.name)),
-    h("td", {}, robot.kind, h("br"), h("span", { className: "muted small" }, TRANSPORT[robot.kind] || robot.transport)),
-    h("td", {}, h("code", {}, address), h("br"), h("span", { className: "muted small" }, `watchdog ${seconds(robot.watchdog_s)}`)),
+    h("td", {}, robot.kind, h("br"), h("span", { class: "muted small" }, TRANSPORT[robot.kind] || robot.transport)),
+    h("td", {}, h("code", {}, address), h("br"), h("span", { class: "muted small" }, `watchdog ${duration(robot.watchdog_s)}`)),
     connectionCell(robot),
     serviceCell,
     h("td", {}, queue.length ? `${queue.length} in the queue` : "empty"),
@@ -111,7 +112,7 @@ function renderRobots() {
           h("h3", {}, "Problems"),
           h(
             "ul",
-            { className: "problems" },
+            { class: "problems" },
             problems.flatMap(([name, lines]) => lines.map((line) => h("li", {}, h("code", {}, name), ": ", line))),
           ),
         ]
@@ -125,7 +126,7 @@ function queueAction(label, testid, robot, place, path, body, cell) {
     "button",
     {
       type: "button",
-      className: testid === "queue-skip" ? "danger small-btn" : "secondary small-btn",
+      class: testid === "queue-skip" ? "danger small-btn" : "secondary small-btn",
       "data-testid": testid,
       dataset: { action: testid },
       "aria-label": `${label}: ${userName(place.user_id) || shortId(place.user_id)} on ${robot.name}`,
@@ -136,7 +137,7 @@ function queueAction(label, testid, robot, place, path, body, cell) {
     busy(button, async () => {
       clearRowError(cell);
       try {
-        await post(`/api/admin/hardware/${enc(robot.name)}/queue/${path}`, body);
+        await api(`/api/admin/hardware/${encodeURIComponent(robot.name)}/queue/${path}`, { method: "POST", body });
         await poll();
       } catch (error) {
         rowError(cell, error);
@@ -151,7 +152,7 @@ function estopButton(runId, cell) {
     "button",
     {
       type: "button",
-      className: "estop small-btn",
+      class: "estop small-btn",
       "data-testid": "queue-estop",
       dataset: { action: "estop" },
       "aria-label": `Emergency stop of run ${shortId(runId)}`,
@@ -162,7 +163,7 @@ function estopButton(runId, cell) {
     busy(button, async () => {
       clearRowError(cell);
       try {
-        await post(`/api/runs/${enc(runId)}/estop`);
+        await api(`/api/runs/${encodeURIComponent(runId)}/estop`, { method: "POST" });
         await poll();
       } catch (error) {
         rowError(cell, error);
@@ -175,18 +176,18 @@ function estopButton(runId, cell) {
 function waitText(place) {
   if (place.state === "offered") return "their turn: to start";
   if (place.state === "running") return "has the robot";
-  return `starts in at most ${seconds(place.estimated_wait_s)}`;
+  return `starts in at most ${duration(place.estimated_wait_s)}`;
 }
 
 function placeRow(robot, place, waitingIndex) {
-  const cell = h("td", { className: "row-actions" });
+  const cell = h("td", { class: "row-actions" });
   if (place.state === "waiting" && waitingIndex > 1) {
     // move counts among the waiting students: up one is their index less one
     cell.append(queueAction("Move up", "queue-move", robot, place, "move", { user_id: place.user_id, position: waitingIndex - 1 }, cell), " ");
   }
   if (place.state === "running" && place.run_id) {
     cell.append(
-      h("a", { href: `/?run=${enc(place.run_id)}`, target: "_blank", rel: "noopener", "aria-label": `Watch run ${shortId(place.run_id)} (new tab)` }, "Watch"),
+      h("a", { href: `/?run=${encodeURIComponent(place.run_id)}`, target: "_blank", rel: "noopener", "aria-label": `Watch run ${shortId(place.run_id)} (new tab)` }, "Watch"),
       " ",
       estopButton(place.run_id, cell),
     );
@@ -196,9 +197,9 @@ function placeRow(robot, place, waitingIndex) {
   return h(
     "tr",
     { dataset: { key: `${robot.name}|${place.user_id}`, userId: place.user_id, state: place.state } },
-    h("td", { className: "num" }, String(place.position)),
+    h("td", { class: "num" }, String(place.position)),
     h("td", {}, who(place.user_id)),
-    h("td", {}, h("span", { className: `state state-${place.state === "offered" ? "starting" : place.state === "running" ? "running" : "paused"}` }, place.state), " ", h("span", { className: "muted small wait" }, waitText(place))),
+    h("td", {}, h("span", { class: `state state-${place.state === "offered" ? "starting" : place.state === "running" ? "running" : "paused"}` }, place.state), " ", h("span", { class: "muted small wait" }, waitText(place))),
     cell,
   );
 }
@@ -211,33 +212,33 @@ function queueBlock(robot) {
   const headingId = `h-queue-${robot.name}`;
   return h(
     "section",
-    { className: "queue", "data-testid": "robot-queue", dataset: { name: robot.name } },
+    { class: "queue", "data-testid": "robot-queue", dataset: { name: robot.name } },
     h(
       "h3",
       { id: headingId },
       h("code", {}, robot.name),
       " ",
-      h("span", { className: "muted small" }, `${queue.places.length} in the queue · slot ${seconds(queue.slot_s)} · start within ${seconds(queue.start_within_s)}${robot.in_service ? "" : " · out of service: the queue waits"}`),
+      h("span", { class: "muted small" }, `${queue.places.length} in the queue · slot ${duration(queue.slot_s)} · start within ${duration(queue.start_within_s)}${robot.in_service ? "" : " · out of service: the queue waits"}`),
     ),
     rows.length
       ? h(
           "div",
-          { className: "table-wrap" },
+          { class: "table-wrap" },
           h(
             "table",
             { "aria-labelledby": headingId },
-            h("thead", {}, h("tr", {}, h("th", { scope: "col" }, "#"), h("th", { scope: "col" }, "Student"), h("th", { scope: "col" }, "State"), h("th", { scope: "col" }, h("span", { className: "sr-only" }, "Actions")))),
+            h("thead", {}, h("tr", {}, h("th", { scope: "col" }, "#"), h("th", { scope: "col" }, "Student"), h("th", { scope: "col" }, "State"), h("th", { scope: "col" }, h("span", { class: "sr-only" }, "Actions")))),
             h("tbody", {}, rows),
           ),
         )
-      : h("p", { className: "muted small" }, "Nobody is waiting."),
+      : h("p", { class: "muted small" }, "Nobody is waiting."),
   );
 }
 
 function renderQueues() {
   const box = $("#robot-queues");
   keepFocus(box, () =>
-    box.replaceChildren(...(robots.length ? robots.map(queueBlock) : [h("p", { className: "muted" }, "No robot, no queue.")])),
+    box.replaceChildren(...(robots.length ? robots.map(queueBlock) : [h("p", { class: "muted" }, "No robot, no queue.")])),
   );
 }
 
@@ -263,7 +264,7 @@ function draw(force = false) {
 // ------------------------------------------------------------------------------ polling
 async function poll() {
   try {
-    const [inventory, bench, status] = await Promise.all([get("/api/admin/robots"), get("/api/hardware"), get("/api/admin/status")]);
+    const [inventory, bench, status] = await Promise.all([api("/api/admin/robots"), api("/api/hardware"), api("/api/admin/status")]);
     clearError($("#hw-error"));
     robots = inventory.robots;
     benches = new Map(bench.robots.map((r) => [r.name, r]));
@@ -292,7 +293,7 @@ function kindChanged(form) {
   form.elements.baud.disabled = !serial;
   $("#robot-address-label").replaceChildren(
     "Address ",
-    h("span", { className: "muted" }, serial ? "(the serial port, e.g. /dev/ttyUSB0)" : "(the CrowBot's IP, as it connects)"),
+    h("span", { class: "muted" }, serial ? "(the serial port, e.g. /dev/ttyUSB0)" : "(the CrowBot's IP, as it connects)"),
   );
   form.elements.address.placeholder = serial ? "/dev/ttyUSB0" : "192.168.1.50";
 }
@@ -313,7 +314,7 @@ async function register(form) {
   }
   if (given.length) body.limits = Object.fromEntries(LIMITS.map((name) => [name, Number(values[name].value)]));
   try {
-    await post("/api/admin/robots", body);
+    await api("/api/admin/robots", { method: "POST", body });
     form.reset();
     kindChanged(form);
     await poll();

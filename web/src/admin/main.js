@@ -1,8 +1,11 @@
 // The instructor console: who is logged in (GET /api/me), the sections behind the nav links
 // (#runs, #users, ...), and the things every section shares (copy buttons, logging out).
+// Served at /admin by `robodojo serve`; bundled by web/build.mjs into web/static/admin.js.
 
-import { ApiError, get, onUnauthorized, post } from "./api.js";
-import { $, $$, copyText, h } from "./dom.js";
+import "./admin.css";
+import { ApiError, api } from "../common/api.js";
+import { h } from "../common/dom.js";
+import { $, $$, copyText } from "./dom.js";
 import { initCourses, showCourses } from "./courses.js";
 import { initExercises, showExercises } from "./exercises.js";
 import { initHardware, showHardware } from "./hardware.js";
@@ -37,10 +40,10 @@ function gate(...content) {
 function tokenForm() {
   const form = h(
     "form",
-    { className: "inline-form token-form", "data-testid": "token-form" },
+    { class: "inline-form token-form", "data-testid": "token-form" },
     h("label", {}, "Invite link or token ", h("input", { name: "token", type: "password", autocomplete: "off", required: true, size: 40 })),
     h("button", { type: "submit" }, "Log in"),
-    h("p", { className: "error wide", role: "alert", hidden: true }),
+    h("p", { class: "error wide", role: "alert", hidden: true }),
   );
   form.addEventListener("submit", async (event) => {
     event.preventDefault();
@@ -52,7 +55,7 @@ function tokenForm() {
     }
     const line = $("p.error", form);
     try {
-      await post("/api/session", { token }, { quiet401: true });
+      await api("/api/session", { method: "POST", body: { token }, quiet401: true });
       window.location.reload();
     } catch (error) {
       line.textContent = error.message;
@@ -79,7 +82,7 @@ function notLoggedIn() {
       h("a", { href: "/admin" }, "/admin"),
       ".",
     ),
-    h("p", { className: "muted" }, "Or paste the link (or its token) here:"),
+    h("p", { class: "muted" }, "Or paste the link (or its token) here:"),
     tokenForm(),
   );
 }
@@ -88,7 +91,7 @@ function notInstructor(me) {
   gate(
     h("h1", {}, "For instructors only"),
     h("p", {}, `You are logged in as ${me.name}, a ${me.role}. This console is for instructors: the lab's page is where your exercises are.`),
-    h("p", {}, h("a", { href: "/", className: "button" }, "Go to the lab")),
+    h("p", {}, h("a", { href: "/", class: "button" }, "Go to the lab")),
   );
 }
 
@@ -131,12 +134,12 @@ async function start() {
   });
   $("#logout").addEventListener("click", async () => {
     try {
-      await post("/api/logout");
+      await api("/api/logout", { method: "POST" });
     } finally {
       notLoggedIn();
     }
   });
-  onUnauthorized(notLoggedIn);
+  window.addEventListener("robodojo:logged-out", notLoggedIn); // a 401 of any later call
   initUsers();
   initRuns();
   initExercises();
@@ -145,10 +148,10 @@ async function start() {
 
   let me;
   try {
-    me = await get("/api/me", { quiet401: true });
+    me = await api("/api/me", { quiet401: true });
   } catch (error) {
     if (error instanceof ApiError && error.status === 401) notLoggedIn();
-    else gate(h("h1", {}, "The server did not answer"), h("p", { className: "error" }, error.message), h("p", {}, "Reload the page to try again."));
+    else gate(h("h1", {}, "The server did not answer"), h("p", { class: "error" }, error.message), h("p", {}, "Reload the page to try again."));
     return;
   }
   state.me = me;
