@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from typing import Any, Self
 
-_NS_PER_S = 1_000_000_000  # [ns/s]
+from sandbox.units import NS_PER_S
 
 
 class _TimeValue:
@@ -24,10 +24,10 @@ class _TimeValue:
             # rospy accepts Time(1.5): float seconds, with nsecs left at 0.
             if nsecs:
                 raise ValueError(f"{type(self).__name__}: give float seconds or nsecs, not both")
-            total = round(secs * _NS_PER_S)
+            total = round(secs * NS_PER_S)
         else:
-            total = int(secs) * _NS_PER_S + int(nsecs)
-        secs_part, nsecs_part = divmod(total, _NS_PER_S)
+            total = int(secs) * NS_PER_S + int(nsecs)
+        secs_part, nsecs_part = divmod(total, NS_PER_S)
         # Mutable attributes, like rospy's, so `msg.header.stamp.secs = 5` keeps working.
         self.secs = secs_part
         self.nsecs = nsecs_part
@@ -35,7 +35,7 @@ class _TimeValue:
     @classmethod
     def from_sec(cls, seconds: float) -> Self:
         """Build from floating-point seconds (rounded to the nearest nanosecond)."""
-        return cls(0, round(seconds * _NS_PER_S))
+        return cls(0, round(seconds * NS_PER_S))
 
     @classmethod
     def from_nsec(cls, nanoseconds: int) -> Self:
@@ -44,11 +44,11 @@ class _TimeValue:
 
     def to_sec(self) -> float:
         """Seconds as a float (loses precision below ~100 ns for current epoch times)."""
-        return self.secs + self.nsecs / _NS_PER_S
+        return self.secs + self.nsecs / NS_PER_S
 
     def to_nsec(self) -> int:
         """Exact integer nanoseconds."""
-        return self.secs * _NS_PER_S + self.nsecs
+        return self.secs * NS_PER_S + self.nsecs
 
     def is_zero(self) -> bool:
         return self.secs == 0 and self.nsecs == 0

@@ -31,12 +31,12 @@ from sandbox.msgs import Duration as Ros1Duration
 from sandbox.msgs import Time as Ros1Time
 from sandbox.msgs import get_message_class as get_ros1_message_class
 from sandbox.msgs._definitions import SERVICES as ROS1_SERVICES
+from sandbox.units import NS_PER_S
 
 from . import get_message_class
 from ._fields import CHECK_FIELDS
 from ._spec import NUMPY_DTYPES, FieldSpec
 
-_NS_PER_S = 1_000_000_000  # [ns/s]
 _TIME = "builtin_interfaces/msg/Time"
 _DURATION = "builtin_interfaces/msg/Duration"
 _DROPPED_GOING_TO_ROS2 = {("std_msgs/Header", "seq")}  # ROS 1 fields ROS 2 removed on purpose
@@ -178,7 +178,7 @@ def _scalar_to_ros2(field: FieldSpec, ros1_field: Any) -> Callable[[Any], Any]:
         cls = get_message_class(field.base)
 
         def stamp(value: Any) -> Any:
-            sec, nanosec = divmod(value.secs * _NS_PER_S + value.nsecs, _NS_PER_S)
+            sec, nanosec = divmod(value.secs * NS_PER_S + value.nsecs, NS_PER_S)
             result = cls.__new__(cls)
             result._check_fields = CHECK_FIELDS
             result._sec, result._nanosec = sec, nanosec

@@ -16,8 +16,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from sandbox.msgs import Duration, Time
-
-NS_PER_S = 1_000_000_000  # [ns/s]
+from sandbox.units import NS_PER_S
 
 
 @dataclass(frozen=True)

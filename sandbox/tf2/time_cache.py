@@ -16,9 +16,9 @@ from __future__ import annotations
 import bisect
 from dataclasses import dataclass
 
-from . import _math
+from sandbox.units import NS_PER_S
 
-NS_PER_S = 1_000_000_000  # [ns/s]
+from . import _math
 
 
 @dataclass(frozen=True)

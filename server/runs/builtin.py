@@ -29,6 +29,7 @@ from sandbox.msgs import Time
 from sandbox.msgs.geometry_msgs import Point, Pose, PoseStamped, Quaternion
 from sandbox.msgs.nav_msgs import MapMetaData, OccupancyGrid, Path
 from sandbox.msgs.std_msgs import Header
+from server.sim.geometry import yaw_quaternion
 
 if TYPE_CHECKING:
     from server.runs.run import Run
@@ -43,7 +44,7 @@ def _pose_stamped(time_s: float, x: float, y: float, yaw: float) -> PoseStamped:
         header=Header(stamp=Time.from_sec(time_s), frame_id="map"),
         pose=Pose(
             position=Point(x=x, y=y),
-            orientation=Quaternion(z=math.sin(yaw / 2), w=math.cos(yaw / 2)),
+            orientation=Quaternion(*yaw_quaternion(yaw)),
         ),
     )
 
@@ -100,9 +101,7 @@ class MapServer(BuiltinNode):
                 height=grid.height,
                 origin=Pose(
                     position=Point(x=grid.origin_x, y=grid.origin_y),
-                    orientation=Quaternion(
-                        z=math.sin(grid.origin_yaw / 2), w=math.cos(grid.origin_yaw / 2)
-                    ),
+                    orientation=Quaternion(*yaw_quaternion(grid.origin_yaw)),
                 ),
             ),
             data=np.asarray(grid.data, dtype=np.int8).reshape(-1).tolist(),

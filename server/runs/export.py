@@ -35,9 +35,9 @@ from mcap.exceptions import McapError
 from mcap.reader import NonSeekingReader, make_reader
 
 from sandbox.msgs import Message, get_message_class
+from sandbox.units import NS_PER_S
 from server.runs.message_fields import FieldShape, byte_value, field_shapes
 
-_NS_PER_S = 1_000_000_000  # [ns/s]
 _UNSAFE_CHARS = re.compile(r"[^\w.\-]+")
 
 Formatter = Callable[[Any], str]
@@ -53,9 +53,9 @@ def csv_file_name(topic: str) -> str:
 
 
 def _seconds(value: Any) -> str:
-    total = value.secs * _NS_PER_S + value.nsecs
+    total = value.secs * NS_PER_S + value.nsecs
     sign = "-" if total < 0 else ""
-    secs, nsecs = divmod(abs(total), _NS_PER_S)
+    secs, nsecs = divmod(abs(total), NS_PER_S)
     return f"{sign}{secs}.{nsecs:09d}"
 
 
@@ -173,7 +173,7 @@ class _TopicCsv:
 
     def write(self, log_time_ns: int, data: bytes) -> None:
         message = self.cls.deserialize(data)
-        self.writer.writerow([repr(log_time_ns / _NS_PER_S), *_row(message, self.columns)])
+        self.writer.writerow([repr(log_time_ns / NS_PER_S), *_row(message, self.columns)])
 
 
 def export_csv(mcap_path: Path, out_dir: Path) -> list[Path]:

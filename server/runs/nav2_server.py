@@ -34,6 +34,7 @@ from sandbox.action_goals import Goal, GoalEvent, GoalStatus, GoalTransitionErro
 from sandbox.msgs import get_message_class
 from sandbox.runtime import format_log_line
 from sandbox.services import request_topic
+from sandbox.units import NS_PER_S
 from server.runs.builtin import BuiltinNode, Planner
 from server.runs.nav2_follow import GoalChecker, PurePursuit
 from server.runs.nav2_navigation import PLANNERS, Navigation, NoPath, Pose, plan_path, yaw_of
@@ -48,11 +49,11 @@ from server.runs.nav2_wire import (
     time_msg,
     with_error,
 )
+from server.sim.geometry import yaw_quaternion
 
 if TYPE_CHECKING:
     from server.runs.run import Run
 
-NS = 1_000_000_000
 CONTROLLER_FREQUENCY_HZ = 20.0  # [Hz] Nav2's controller_server default
 SERVICE_PATIENCE_S = 1.0  # [s] a goal waits this long for an unserved controller service
 TURNING_RADIUS_M = 0.4  # [m] SMAC Hybrid-A*'s minimum_turning_radius default
@@ -76,9 +77,7 @@ def _pose_stamped(x: float, y: float, yaw: float, time_ns: int) -> Any:
         pose=_msg(
             "geometry_msgs/msg/Pose",
             position=_msg("geometry_msgs/msg/Point", x=float(x), y=float(y)),
-            orientation=_msg(
-                "geometry_msgs/msg/Quaternion", z=math.sin(yaw / 2), w=math.cos(yaw / 2)
-            ),
+            orientation=_msg("geometry_msgs/msg/Quaternion", **yaw_quaternion(yaw)._asdict()),
         ),
     )
 
@@ -369,7 +368,7 @@ class NavigationServer(BuiltinNode):
         speed = run.sim.state.linear_m_s
         feedback = nav.wire.action.Feedback(
             current_pose=_pose_stamped(*pose, run.time_ns),
-            navigation_time=duration_msg((run.time_ns - nav.started_ns) / NS),
+            navigation_time=duration_msg((run.time_ns - nav.started_ns) / NS_PER_S),
             estimated_time_remaining=duration_msg(nav.eta_s(pose, speed)),
             number_of_recoveries=0,
             distance_remaining=nav.distance_remaining(pose),
@@ -387,7 +386,7 @@ class NavigationServer(BuiltinNode):
             if nav.service_missing_since_ns is None:
                 nav.service_missing_since_ns = run.time_ns
                 self.log(run, "WARN", f"controller service '{client.service}' is not available")
-            if run.time_ns - nav.service_missing_since_ns >= SERVICE_PATIENCE_S * NS:
+            if run.time_ns - nav.service_missing_since_ns >= SERVICE_PATIENCE_S * NS_PER_S:
                 return self._finish_navigation(
                     run, GoalEvent.ABORT, "INVALID_CONTROLLER",
                     f"no node serves '{client.service}' ({CONTROLLER_SERVICE_TYPE}): the "

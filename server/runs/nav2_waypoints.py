@@ -14,13 +14,13 @@ from typing import TYPE_CHECKING, Any
 
 from sandbox.action_goals import Goal, GoalEvent, GoalStatus
 from sandbox.msgs import get_message_class
+from sandbox.units import NS_PER_S
 from server.runs.nav2_wire import with_error
 
 if TYPE_CHECKING:
     from server.runs.nav2_server import NavigationServer
     from server.runs.run import Run
 
-NS = 1_000_000_000
 WAYPOINT_PAUSE_S = 0.2  # [s] WaitAtWaypoint's waypoint_pause_duration default (200 ms)
 
 
@@ -94,7 +94,7 @@ class WaypointFollower:
             return []
         mission.nav_uuid = None
         if status is GoalStatus.SUCCEEDED:
-            mission.resume_ns = run.time_ns + round(WAYPOINT_PAUSE_S * NS)
+            mission.resume_ns = run.time_ns + round(WAYPOINT_PAUSE_S * NS_PER_S)
             return []
         mission.missed.append((mission.index, int(getattr(result, "error_code", 0))))
         if self.server.stop_on_failure or status is GoalStatus.CANCELED:

@@ -21,8 +21,8 @@ from typing import Any
 from sandbox.action_goals import ActionGoals, GoalStatus
 from sandbox.msgs import get_message_class
 from sandbox.services import REPLY_PREFIX, request_topic
+from sandbox.units import NS_PER_S
 
-NS = 1_000_000_000
 SERVICE_CALL = "robodojo_msgs/msg/ServiceCall"
 SERVICE_REPLY = "robodojo_msgs/msg/ServiceReply"
 STATUS_TYPE = "action_msgs/msg/GoalStatusArray"
@@ -58,18 +58,20 @@ def with_error(result: Any, code_name: str, message: str) -> Any:
 
 
 def time_msg(time_ns: int) -> Any:
-    return get_message_class("builtin_interfaces/msg/Time")(sec=time_ns // NS, nanosec=time_ns % NS)
+    return get_message_class("builtin_interfaces/msg/Time")(
+        sec=time_ns // NS_PER_S, nanosec=time_ns % NS_PER_S
+    )
 
 
 def duration_msg(seconds: float) -> Any:
-    time_ns = max(round(seconds * NS), 0)
+    time_ns = max(round(seconds * NS_PER_S), 0)
     return get_message_class("builtin_interfaces/msg/Duration")(
-        sec=time_ns // NS, nanosec=time_ns % NS
+        sec=time_ns // NS_PER_S, nanosec=time_ns % NS_PER_S
     )
 
 
 def stamp_ns(stamp: Any) -> int:
-    return int(stamp.sec) * NS + int(stamp.nanosec)
+    return int(stamp.sec) * NS_PER_S + int(stamp.nanosec)
 
 
 def uuid_msg(uuid: bytes) -> Any:

@@ -1,19 +1,29 @@
-"""The pure simulation core: robots, worlds, sensors and physics. No I/O, no wall clock."""
+"""The pure simulation core: robots, worlds, sensors and physics. No I/O, no wall clock.
 
+`__all__` is the public surface: what notebooks, tests and the run engine may import from
+`server.sim` itself. Anything else lives in a submodule and may change without notice.
+"""
+
+from server.sim.backend import RobotBackend, WorldView
 from server.sim.registry import get_robot, robot_ids, robots_for_world
+from server.sim.robots.base import Direction, TopicSpec
 from server.sim.simulation import EventKind, Published, Scene, SimEvent, Simulation, SimulationError
 from server.sim.state import Pose2D, RobotState
 from server.sim.world import load_world, world_ids
 
 __all__ = [
+    "Direction",
     "EventKind",
     "Pose2D",
     "Published",
+    "RobotBackend",
     "RobotState",
     "Scene",
     "SimEvent",
     "Simulation",
     "SimulationError",
+    "TopicSpec",
+    "WorldView",
     "get_robot",
     "load_world",
     "robot_ids",

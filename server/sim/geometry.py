@@ -1,5 +1,6 @@
 """Plane geometry shared by the world, its solid surfaces and the floor sensors: distances from a
-point to line segments (walls, box edges, tape strips) and to circles (plants, posts).
+point to line segments (walls, box edges, tape strips) and to circles (plants, posts); and a
+heading as the quaternion ROS messages carry (`yaw_quaternion`, the one place it is written).
 
 Segments are (N, 4) rows (x1, y1, x2, y2) [m]; the queries take them as `segment_arrays` returns
 them, so a caller that asks many times (`Obstacles`) prepares the arrays once.
@@ -8,10 +9,28 @@ them, so a caller that asks many times (`Obstacles`) prepares the arrays once.
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 
 _MIN_LENGTH_SQ = 1e-18  # [m^2] a zero-length segment is its start point, not a division by zero
+
+
+class Quaternion(NamedTuple):
+    """A unit quaternion's components in ROS order (geometry_msgs/Quaternion: x, y, z, w)."""
+
+    x: float
+    y: float
+    z: float
+    w: float
+
+
+def yaw_quaternion(yaw_rad: float) -> Quaternion:
+    """The rotation by `yaw_rad` [rad] about +z (counter-clockwise seen from above, REP 103).
+
+    A plain tuple so ROS 1 and ROS 2 messages alike take it: `Quaternion(*q)`, `**q._asdict()`."""
+    half = 0.5 * float(yaw_rad)
+    return Quaternion(0.0, 0.0, math.sin(half), math.cos(half))
 
 
 def segment_arrays(segments: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -24,15 +24,15 @@ from enum import StrEnum
 
 import numpy as np
 
+from sandbox.units import NS_PER_S
 from server.sim.kinematics import body_velocities, integrate_arc, wrap_angle
 from server.sim.obstacles import Obstacles
 from server.sim.registry import get_robot, robots_for_world
 from server.sim.robots.base import Direction, TopicSpec
 from server.sim.sensors.base import SenseContext, Sensor
 from server.sim.state import Pose2D, RobotState
-from server.sim.world import LightSource, World, load_world
+from server.sim.world import LightSource, World, WorldError, load_world
 
-NS_PER_S = 1_000_000_000
 DEFAULT_PHYSICS_HZ = 1000.0  # [Hz] fine enough that a 0.13 m/s robot moves 0.13 mm per tick
 # Odometry miscalibration: each wheel's effective radius differs from the nominal one by a
 # seeded draw of this relative standard deviation, so dead reckoning drifts like a real base.
@@ -174,19 +174,16 @@ class Simulation:
         self._latest: dict[str, object] = {}
         self._events: list[SimEvent] = []
         self._clearance_m = 0.0
-        self._out_of_bounds = not self._inside_bounds(spawn.x, spawn.y)
+        self._out_of_bounds = not self.world.in_bounds(spawn.x, spawn.y)
         return self._publish_due()
 
     def _spawn_pose(self, spawn: str | Pose2D | None) -> Pose2D:
         if isinstance(spawn, Pose2D):
             return Pose2D(spawn.x, spawn.y, spawn.yaw)
-        spawns = {s.name: s for s in self.world.spawns}
-        name = spawn or self.world.spawns[0].name
-        if name not in spawns:
-            raise SimulationError(
-                f"world '{self.world.id}' has no spawn '{name}'; choose one of {sorted(spawns)}"
-            )
-        chosen = spawns[name]
+        try:
+            chosen = self.world.spawn(spawn or None)
+        except WorldError as error:
+            raise SimulationError(str(error)) from None
         return Pose2D(chosen.x, chosen.y, chosen.yaw)
 
     # ----------------------------------------------------------------------------- topics
@@ -249,8 +246,8 @@ class Simulation:
             raise SimulationError(f"world '{self.world.id}' has no light '{name}'; lights: {names}")
         if not (math.isfinite(x) and math.isfinite(y)):
             raise SimulationError(f"light position must be finite, got ({x}, {y})")
-        min_x, min_y, max_x, max_y = self.world.bounds
-        if not (min_x <= x <= max_x and min_y <= y <= max_y):
+        if not self.world.in_bounds(x, y):
+            min_x, min_y, max_x, max_y = self.world.bounds
             raise SimulationError(
                 f"({x:.2f}, {y:.2f}) is outside the world ({min_x}..{max_x}, {min_y}..{max_y} m)"
             )
@@ -321,8 +318,7 @@ class Simulation:
         odom.x, odom.y, odom.yaw = integrate_arc(odom.x, odom.y, odom.yaw, odom_v, odom_w, dt)
         self._now_ns += self._tick_ns
         self.robot.advance(state, dt, self._now_ns / NS_PER_S)
-        min_x, min_y, max_x, max_y = self.world.bounds
-        if self._out_of_bounds or not (min_x <= x <= max_x and min_y <= y <= max_y):
+        if self._out_of_bounds or not self.world.in_bounds(x, y):
             self._track_bounds(x, y, dt)
 
     def _resolve_contacts(
@@ -372,12 +368,8 @@ class Simulation:
         state.in_contact = touching
         state.contact_angles_rad = angles
 
-    def _inside_bounds(self, x: float, y: float) -> bool:
-        min_x, min_y, max_x, max_y = self.world.bounds
-        return min_x <= x <= max_x and min_y <= y <= max_y
-
     def _track_bounds(self, x: float, y: float, dt: float) -> None:
-        outside = not self._inside_bounds(x, y)
+        outside = not self.world.in_bounds(x, y)
         if outside:
             self.state.time_out_of_bounds_s += dt
         if outside != self._out_of_bounds:

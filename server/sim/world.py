@@ -132,7 +132,7 @@ class World:
             if spawn.name == name:
                 return spawn
         valid = ", ".join(s.name for s in self.spawns)
-        raise WorldError(f"world {self.id!r}: no spawn named {name!r} (valid: {valid})")
+        raise WorldError(f"world '{self.id}' has no spawn '{name}'; choose one of: {valid}")
 
     def clearance(self, x: float, y: float) -> float:
         """Distance [m] from (x, y) to the nearest wall, box edge or cylinder surface; negative

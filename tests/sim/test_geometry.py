@@ -7,7 +7,12 @@ import math
 import numpy as np
 import pytest
 
-from server.sim.geometry import distance_to_nearest, offsets_from_segments, segment_arrays
+from server.sim.geometry import (
+    distance_to_nearest,
+    offsets_from_segments,
+    segment_arrays,
+    yaw_quaternion,
+)
 
 SEGMENTS = np.array(
     [
@@ -43,3 +48,14 @@ def test_distance_to_nearest_takes_segments_and_circle_surfaces() -> None:
 def test_distance_to_nearest_in_an_empty_world_is_infinite() -> None:
     nothing = segment_arrays(np.zeros((0, 4)))
     assert distance_to_nearest(np.zeros(2), nothing, np.zeros((0, 2)), np.zeros(0)) == math.inf
+
+
+@pytest.mark.parametrize("yaw", [0.0, 0.7, -2.5, math.pi])
+def test_yaw_quaternion_is_the_unit_rotation_about_z(yaw: float) -> None:
+    q = yaw_quaternion(yaw)
+    assert (q.x, q.y) == (0.0, 0.0)
+    assert math.hypot(*q) == pytest.approx(1.0)
+    # Rotating +x by q (v' = q v q*, for a rotation about z) gives the heading vector.
+    heading_x = q.w * q.w - q.z * q.z
+    heading_y = 2.0 * q.w * q.z
+    assert (heading_x, heading_y) == pytest.approx((math.cos(yaw), math.sin(yaw)))

@@ -65,7 +65,7 @@ def test_unknown_world_id_lists_the_valid_ids() -> None:
 def test_unknown_spawn_name_lists_the_spawns() -> None:
     world = load_world("office")
     assert world.spawn() is world.spawns[0] and world.spawn("corridor").name == "corridor"
-    with pytest.raises(WorldError, match=r"no spawn named 'kitchen' \(valid: start, corridor"):
+    with pytest.raises(WorldError, match=r"has no spawn 'kitchen'; choose one of: start, corridor"):
         world.spawn("kitchen")
 
 

@@ -17,11 +17,11 @@ Pure: the caller passes the frames and the times; no port, no thread, no clock.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Iterable
 
 from sandbox.msgs import Message, Time, get_message_class
 from server.hardware.create import kinematics, oi
+from server.sim.geometry import yaw_quaternion
 
 TOPIC_CMD_VEL = "cmd_vel"
 TOPIC_ODOM = "odom"
@@ -124,8 +124,8 @@ class CreateTopics:
         message.child_frame_id = self.child_frame_id
         message.pose.pose.position.x = pose.x_m
         message.pose.pose.position.y = pose.y_m
-        message.pose.pose.orientation.z = math.sin(0.5 * pose.yaw_rad)
-        message.pose.pose.orientation.w = math.cos(0.5 * pose.yaw_rad)
+        orientation = message.pose.pose.orientation
+        _, _, orientation.z, orientation.w = yaw_quaternion(pose.yaw_rad)
         message.pose.covariance = _diagonal(POSE_VARIANCES)
         message.twist.twist.linear.x = linear_m_s
         message.twist.twist.angular.z = angular_rad_s

@@ -52,6 +52,7 @@ from sandbox.msgs import (
 )
 from sandbox.msgs import Time as RosTime
 from sandbox.msgs.std_msgs import Time as TimeMessage
+from sandbox.units import NS_PER_S
 from server.hardware.rosserial.events import (
     Closed,
     Direction,
@@ -80,7 +81,6 @@ from server.hardware.rosserial.frames import (
 from server.hardware.rosserial.limits import DEFAULT_LIMITS, RosserialLimits
 from server.hardware.rosserial.messages import Log, LogLevel, TopicInfo
 
-_NS_PER_S = 1_000_000_000
 _SERVICE_IDS = {
     TopicId.SERVICE_SERVER,
     TopicId.SERVICE_SERVER + 1,
@@ -282,7 +282,7 @@ class RosserialSession:
             self.stats.time_requests += 1
             self.synced = True
             self._last_sync_s = now_s
-            secs, nsecs = divmod(self._clock_ns(), _NS_PER_S)
+            secs, nsecs = divmod(self._clock_ns(), NS_PER_S)
             self._queue(encode_frame(TopicId.TIME, TimeMessage(RosTime(secs, nsecs)).serialize()))
             return []
         if topic_id in (TopicId.PUBLISHER, TopicId.SUBSCRIBER):

@@ -12,14 +12,14 @@ import math
 from sandbox.msgs import Time
 from sandbox.msgs.geometry_msgs import Quaternion
 from sandbox.msgs.std_msgs import Header
+from server.sim.geometry import yaw_quaternion
 
 TWO_PI = 2.0 * math.pi
 
 
-def yaw_quaternion(yaw_rad: float) -> Quaternion:
-    """The unit quaternion of a rotation by `yaw_rad` about +z."""
-    half = 0.5 * float(yaw_rad)
-    return Quaternion(x=0.0, y=0.0, z=math.sin(half), w=math.cos(half))
+def yaw_orientation(yaw_rad: float) -> Quaternion:
+    """The geometry_msgs/Quaternion of a rotation by `yaw_rad` [rad] about +z."""
+    return Quaternion(*yaw_quaternion(yaw_rad))
 
 
 def stamped_header(time_s: float, frame_id: str) -> Header:

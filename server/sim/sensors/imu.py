@@ -31,7 +31,7 @@ from sandbox.msgs.sensor_msgs import Imu as ImuMessage
 from sandbox.msgs.std_msgs import Float32
 from server.sim.kinematics import wrap_angle
 from server.sim.sensors.base import SenseContext
-from server.sim.sensors.frames import diagonal_covariance, stamped_header, yaw_quaternion
+from server.sim.sensors.frames import diagonal_covariance, stamped_header, yaw_orientation
 
 # Defaults (assumptions of BNO055 order unless noted)
 # | name                      | value  | unit        | why                                     |
@@ -167,7 +167,7 @@ class Imu:
             orientation_var, gyro_var, accel_var = ((v, v, v) for v in self.fixed_covariances)
         return ImuMessage(
             header=stamped_header(ctx.time_s, self.frame_id),
-            orientation=yaw_quaternion(yaw_rad),
+            orientation=yaw_orientation(yaw_rad),
             orientation_covariance=diagonal_covariance(orientation_var),
             angular_velocity=Vector3(
                 x=0.0, y=0.0, z=state.angular_rad_s + self.gyro_noise_sd_rad_s * gyro_noise

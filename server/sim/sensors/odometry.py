@@ -30,7 +30,7 @@ from sandbox.msgs.nav_msgs import Odometry
 from sandbox.msgs.std_msgs import Int32MultiArray
 from server.sim.kinematics import wrap_angle
 from server.sim.sensors.base import SenseContext, StatelessSensor
-from server.sim.sensors.frames import diagonal_covariance, stamped_header, yaw_quaternion
+from server.sim.sensors.frames import diagonal_covariance, stamped_header, yaw_orientation
 
 # Defaults
 # | name                    | value  | unit   | why                                              |
@@ -89,7 +89,7 @@ class WheelOdometry(StatelessSensor):
         )
         odometry.pose.pose = Pose(
             position=Point(x=odom_pose.x, y=odom_pose.y, z=0.0),
-            orientation=yaw_quaternion(odom_pose.yaw),
+            orientation=yaw_orientation(odom_pose.yaw),
         )
         odometry.pose.covariance = list(self.pose_covariance)
         odometry.twist.twist = Twist(
