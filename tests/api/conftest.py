@@ -22,6 +22,8 @@ import httpx
 import pytest
 
 START_TIMEOUT_S = 60.0  # [s] cold start with a sandbox pool on a loaded 2-core machine
+# [s] for the last lines after the server exits; a sandbox that outlives it may hold the pipe
+OUTPUT_END_TIMEOUT_S = 2.0
 LOGIN_LINE = re.compile(r"log in as the instructor at (\S+/login\?token=(\S+))")
 # Drives forward and stops before the wall (the CLI demo's controller, trimmed).
 STEP_CONTROLLER = """\
@@ -76,6 +78,7 @@ class LabServer:
     output: list[str] = field(default_factory=list)
     clients: list[httpx.Client] = field(default_factory=list)
     database_url: str = ""  # the store the server uses, for tests that look behind the API
+    output_pump: threading.Thread | None = None  # reads the server's output into `output`
 
     def client(self, token: str | None = None) -> httpx.Client:
         """A client closed at the end of the test (the `_close_clients` fixture)."""
@@ -140,7 +143,8 @@ def start_server(
         except (ValueError, OSError):  # closed by stop_server: the server is gone
             return
 
-    threading.Thread(target=pump, daemon=True).start()
+    output_pump = threading.Thread(target=pump, name="lab-output", daemon=True)
+    output_pump.start()
     url = f"http://127.0.0.1:{port}"
     deadline = time.monotonic() + START_TIMEOUT_S
     while time.monotonic() < deadline:
@@ -158,7 +162,9 @@ def start_server(
     from server.store.db import sqlite_url
 
     database_url = env.get("ROBODOJO_DATABASE_URL") or sqlite_url(data)
-    return LabServer(url, found.get("token", ""), process, data, output, [], database_url)
+    return LabServer(
+        url, found.get("token", ""), process, data, output, [], database_url, output_pump
+    )
 
 
 def stop_server(server: LabServer, timeout_s: float = 30.0) -> int:
@@ -170,7 +176,8 @@ def stop_server(server: LabServer, timeout_s: float = 30.0) -> int:
         server.process.kill()
         return server.process.wait()
     finally:
-        time.sleep(0.1)  # the output pump reads the last lines
+        if server.output_pump is not None:  # it reads the last lines, up to the pipe's end
+            server.output_pump.join(OUTPUT_END_TIMEOUT_S)
         if server.process.stdout is not None:
             server.process.stdout.close()
 

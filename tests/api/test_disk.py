@@ -101,7 +101,9 @@ def test_retention_removes_old_runs_files_and_keeps_their_metrics(disk_lab):
     assert not before["files_removed"]
     assert admin.get(f"/api/runs/{run_id}/recording.mcap").status_code == 200
 
-    time.sleep(0.2)  # the run ended more than 0.1 s ago, so a retention of ~0.09 s takes it
+    # Not a wait for an event: the run must age past ~0.1 s so that a retention of ~0.09 s
+    # takes it (retention is by age).
+    time.sleep(0.2)
     answer = admin.put("/api/admin/retention", json={"retention_days": 1e-6})
     assert answer.status_code == 200, answer.text
     assert answer.json()["runs_with_files_removed_now"] == 1

@@ -355,8 +355,9 @@ def test_leaving_safe_mode_is_reported(emulator, recorder):
         assert wait_for(lambda: driver.oi_mode is oi.OIMode.PASSIVE)
         assert driver.problem is not None
         assert "Passive mode, not Safe (a wheel dropped?)" in driver.problem
+        heard = len(emulator.received)
         driver.command(twist(0.2))
-        time.sleep(0.05)
+        assert wait_for(lambda: len(emulator.received) > heard)
         assert emulator.left_mm_s == 0  # the robot ignores drive commands in Passive
         emulator.put_down()
         driver.rearm()
@@ -460,7 +461,7 @@ def test_emulator_ignores_commands_in_the_wrong_mode(emulator):
     with serial.Serial(emulator.port, 115200, timeout=0.1) as port:
         drive = oi.encode_drive_direct(100, 100)
         port.write(drive)  # Off: only Start is heard
-        time.sleep(0.05)
+        time.sleep(0.05)  # not a wait: nothing may happen in this time (no event to wait for)
         assert emulator.received == [] and emulator.left_mm_s == 0
         port.write(oi.encode_opcode(oi.Opcode.START) + drive)  # Passive: heard, not obeyed
         assert wait_for(lambda: len(emulator.received) == 2)
@@ -470,7 +471,7 @@ def test_emulator_ignores_commands_in_the_wrong_mode(emulator):
         port.write(oi.encode_opcode(oi.Opcode.STOP) + oi.encode_sensors(7))  # Off again
         assert wait_for(lambda: emulator.mode is oi.OIMode.OFF)
         assert emulator.left_mm_s == 0
-        time.sleep(0.05)
+        time.sleep(0.05)  # not a wait: no answer may come in this time (nor in the read's 0.1 s)
         assert port.read(10) == b""  # Sensors went unheard
 
 

@@ -15,6 +15,7 @@ from server.hardware.create import oi
 from server.hardware.create.link import CreateLink
 from server.hardware.safety import MotionLimits
 from tests.hardware.create_emulator import CreateEmulator
+from tests.waiting import wait_until
 
 LIMITS = MotionLimits(
     max_linear_m_s=0.3,
@@ -33,12 +34,22 @@ def test_a_hardware_run_drives_the_create_and_reads_odom_and_bumper():
             robot.reset()
             published = []
             end = time.monotonic() + 0.5
-            while time.monotonic() < end:
+            while time.monotonic() < end:  # a run's loop: drive at 50 Hz for 0.5 s
                 robot.apply("cmd_vel", Twist(linear=Vector3(x=0.2)))
                 published += robot.step(0.02)
                 time.sleep(0.02)
             robot.stop()
-            time.sleep(0.1)
+            wait_until(
+                lambda: emulator.commands(oi.Opcode.DRIVE_DIRECT)[-1] == bytes(4),
+                2,
+                "the Create got the zero drive command",
+            )
+            frames = link.driver.stats.frames
+            wait_until(
+                lambda: link.driver.stats.frames >= frames + 2,
+                2,
+                "two sensor frames of the stopped Create reached the link",
+            )
             published += robot.step(0.1)
             topics = {p.topic for p in published}
             assert topics == {"odom", "bumper"}
@@ -61,9 +72,7 @@ def test_a_silent_create_ends_the_run_with_the_drivers_sentence():
             robot.reset()
             assert link.connected and link.lost_reason == ""
             emulator.go_silent()
-            deadline = time.monotonic() + 2.0
-            while link.connected and time.monotonic() < deadline:
-                time.sleep(0.01)
+            wait_until(lambda: not link.connected, 2, "the link noticed the silent Create")
             with pytest.raises(RobotLost, match="no sensor frame from the Create"):
                 robot.step(0.02)
         finally:
@@ -77,7 +86,13 @@ def test_only_cmd_vel_is_taken_and_the_inbox_is_bounded():
         try:
             with pytest.raises(ValueError, match="takes only 'cmd_vel'"):
                 link.send("Leds", object())
-            time.sleep(0.5)  # ~20 messages arrive; the 5 newest are kept
+            frames = link.driver.stats.frames
+            # Each frame brings odom and bumper: 8 frames overflow the inbox of 5.
+            wait_until(
+                lambda: link.driver.stats.frames >= frames + 8,
+                5,
+                "8 sensor frames of the Create reached the link",
+            )
             taken = link.take_received()
             assert len(taken) == 5
             assert [t for t in taken if t[2] > time.monotonic()] == []

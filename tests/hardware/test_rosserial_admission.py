@@ -27,6 +27,7 @@ from server.hardware.rosserial import (
 from tests.api.conftest import LabServer, start_server, stop_server, wait_for_end
 from tests.hardware.crowbot_firmware import CrowBotFirmware
 from tests.hardware.test_serve_hardware import ROSPY
+from tests.waiting import wait_until
 
 ROBOT = "127.0.0.1"  # the firmware emulator's source address
 STRANGER = "127.0.0.2"
@@ -151,13 +152,22 @@ def test_idle_sockets_from_a_registered_address_cannot_hold_the_slots():
         idle = [connect_from(ROBOT, server.port) for _ in range(6)]
         try:
             assert all(first_bytes(sock) for sock in idle)  # admitted: the topic request came
-            time.sleep(0.2)
+            wait_until(
+                lambda: (
+                    len([r for r in server.robots() if not r.announced])
+                    <= DEFAULT_LIMITS.max_pending_per_address
+                ),
+                5,
+                "the server closed the older pending connections of the address",
+            )
             pending = [r for r in server.robots() if not r.announced]
             assert len(pending) == DEFAULT_LIMITS.max_pending_per_address  # the newest two
             with CrowBotFirmware(ROBOT, server.port) as firmware:
                 assert firmware.wait_until(lambda: firmware.configured, 5), "robot turned away"
                 assert firmware.wait_until(lambda: len(handler.ready) == 1, 5)
-                time.sleep(3.5)  # past the handshake timeout (settle_s made the robot ready)
+                # Not a wait for an event: the handshaken robot must outlive its own handshake
+                # timeout (3 s; settle_s made it ready before that).
+                time.sleep(3.5)
                 assert [r.id for r in server.robots()] == [handler.ready[0].id]
                 assert firmware.connected and firmware.configured  # the handshaken one stays
             closed = [first_bytes(sock, 0.5) for sock in idle]

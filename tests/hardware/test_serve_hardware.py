@@ -14,6 +14,7 @@ from mcap.reader import make_reader
 
 from tests.api.conftest import LabServer, start_server, stop_server, wait_for_end
 from tests.hardware.crowbot_firmware import CrowBotFirmware, FirmwareOptions
+from tests.waiting import wait_until
 
 ROSPY = """\
 import rospy
@@ -45,10 +46,12 @@ def bench(tmp_path_factory) -> Iterator[tuple[LabServer, CrowBotFirmware]]:
     assert made.status_code == 201, made.text
     firmware = CrowBotFirmware("127.0.0.1", port, FirmwareOptions(log_commands=True)).start()
     assert firmware.wait_until(lambda: firmware.configured, 10), "the firmware did not negotiate"
-    deadline = time.monotonic() + 10
-    while admin.get("/api/admin/robots").json()["robots"][0]["connection"] != "connected":
-        assert time.monotonic() < deadline, admin.get("/api/admin/robots").json()
-        time.sleep(0.1)
+    wait_until(
+        lambda: admin.get("/api/admin/robots").json()["robots"][0]["connection"] == "connected",
+        10,
+        "the server counted crowbot-1 as connected",
+        poll_s=0.1,
+    )
     server.close_clients()
     yield server, firmware
     firmware.stop()
@@ -153,8 +156,13 @@ def test_a_robot_that_disconnects_ends_its_run(bench):
     ).json()  # fmt: skip
     wait_for_end(student, simulated["id"])
     student.post("/api/hardware/crowbot-1/queue")
+    before = len(firmware.received_on("Control"))
     run_id = hardware_run(student, ROSPY, duration=30).json()["id"]
-    time.sleep(1.0)
+    wait_until(
+        lambda: len(firmware.received_on("Control")) > before,
+        10,
+        "the hardware run's first command reached the robot",
+    )
     firmware._close()  # the robot's WiFi drops
     run = wait_for_end(student, run_id, timeout_s=20)
     assert run["state"] == "failed" and run["reason"] == "failed: robot disconnected"
@@ -164,10 +172,12 @@ def test_a_robot_that_disconnects_ends_its_run(bench):
     firmware.start()
     assert firmware.wait_until(lambda: firmware.configured, 10)
     admin = server.admin()
-    deadline = time.monotonic() + 10
-    while admin.get("/api/admin/robots").json()["robots"][0]["connection"] != "connected":
-        assert time.monotonic() < deadline, "the robot did not rejoin the pool"
-        time.sleep(0.1)
+    wait_until(
+        lambda: admin.get("/api/admin/robots").json()["robots"][0]["connection"] == "connected",
+        10,
+        "the robot rejoined the pool",
+        poll_s=0.1,
+    )
 
 
 CREATE_DRIVER = """\
@@ -227,7 +237,14 @@ def test_a_turn_on_the_robot_ends_when_its_slot_is_over(tmp_path):
         assert admin.post("/api/admin/robots", json=robot).status_code == 201
         with CrowBotFirmware("127.0.0.1", port) as firmware:
             assert firmware.wait_until(lambda: firmware.configured, 10)
-            time.sleep(0.5)
+            wait_until(
+                lambda: (
+                    admin.get("/api/admin/robots").json()["robots"][0]["connection"] == "connected"
+                ),
+                10,
+                "the server counted crowbot-9 as connected",
+                poll_s=0.1,
+            )
             student = server.student("eve")
             student.post("/api/hardware/crowbot-9/queue")
             started = student.post(

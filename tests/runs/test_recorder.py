@@ -27,6 +27,7 @@ from server.runs.recorder import (
 from server.runs.safe_paths import safe_name, safe_relative_path
 from server.runs.tf import tf_message
 from server.sim import Simulation
+from tests.waiting import wait_until
 
 NS_PER_S = 1_000_000_000
 # Where the crop rover's sensors sit; the YDLidar sweeps clockwise, hence the roll (see tf.py).
@@ -310,7 +311,14 @@ def test_a_producer_blocked_by_backpressure_is_released_when_the_writer_fails(tm
 def test_logs_append_across_calls(tmp_path) -> None:
     recorder = Recorder(tmp_path, "r")
     recorder.write_log("follower", ["step 1", "step 2\n"])
-    time.sleep(0.1)  # let the writer flush the first part
+    wait_until(
+        lambda: (
+            (tmp_path / "logs" / "follower.log").is_file()
+            and (tmp_path / "logs" / "follower.log").read_text() == "step 1\nstep 2\n"
+        ),
+        5,
+        "the writer wrote the first part of the log",
+    )
     recorder.write_log("follower", ["step 3"])
     recorder.write_log("../../evil", ["escaped?"])
     paths = recorder.close()
