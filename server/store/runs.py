@@ -80,6 +80,33 @@ def listing(db: Db, where: RunFilter) -> tuple[list[RunRecord], int]:
     return list(rows), total
 
 
+GATE_RUNS_SEARCHED = 200  # the newest finished runs compared; older passes must be redone
+
+
+def finished_simulation_run(
+    db: Db, user_id: str, exercise_id: str | None, robot: str, code: list[dict]
+) -> str | None:
+    """The id of the newest simulation run of this user, exercise (None: free play) and robot
+    that finished with exactly this code, or None: the simulation gate before a hardware run."""
+    query = (
+        select(RunRecord)
+        .where(
+            RunRecord.user_id == user_id,
+            RunRecord.state == str(RunState.FINISHED),
+            RunRecord.robot == robot,
+            RunRecord.exercise_id.is_(None)
+            if exercise_id is None
+            else RunRecord.exercise_id == exercise_id,
+        )
+        .order_by(RunRecord.created_at.desc())
+        .limit(GATE_RUNS_SEARCHED)
+    )
+    for record in db.scalars(query):
+        if record.code == code and record.hardware is None:
+            return record.id
+    return None
+
+
 def active_count(db: Db, user_id: str | None = None) -> int:
     query = select(func.count()).select_from(RunRecord).where(RunRecord.state.in_(ACTIVE_STATES))
     if user_id is not None:

@@ -16,7 +16,8 @@ from server.api.routes.admin_robots import robot_or_404
 from server.api.schemas import Strict
 from server.hardware.queue import QueueError
 from server.store import robots as inventory
-from server.store.models import RobotEntry, RunRecord
+from server.store import runs as run_store
+from server.store.models import RobotEntry
 
 router = APIRouter(tags=["hardware"])
 
@@ -113,23 +114,14 @@ def skip(name: str, body: QueueMove, request: Request, _: Caller = Depends(instr
 def simulation_gate(request: Request, user_id: str, exercise_id: str | None, robot: str,
                     nodes: list[dict]) -> dict:  # fmt: skip
     """The verdict: has this code finished a simulation run of the same exercise (or robot)?"""
-    from sqlalchemy import select
-
     with request.app.state.store.session() as db:
-        query = select(RunRecord).where(
-            RunRecord.user_id == user_id,
-            RunRecord.state == "finished",
-            RunRecord.robot == robot,
-            RunRecord.exercise_id.is_(None) if exercise_id is None
-            else RunRecord.exercise_id == exercise_id,
-        ).order_by(RunRecord.created_at.desc()).limit(200)  # fmt: skip
-        for record in db.scalars(query):
-            if record.code == nodes and record.hardware is None:
-                return {
-                    "passed": True,
-                    "simulation_run": record.id,
-                    "reason": "this code finished a simulation run of the same exercise",
-                }
+        passed = run_store.finished_simulation_run(db, user_id, exercise_id, robot, nodes)
+    if passed is not None:
+        return {
+            "passed": True,
+            "simulation_run": passed,
+            "reason": "this code finished a simulation run of the same exercise",
+        }
     what = f"exercise '{exercise_id}'" if exercise_id else f"the {robot} in free play"
     return {
         "passed": False,
