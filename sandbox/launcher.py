@@ -120,6 +120,12 @@ class Launcher:
         node.name = name
         return node
 
+    @property
+    def warm_count(self) -> int:
+        """How many warm nodes wait in the pool now (for the lab's status)."""
+        with self._lock:
+            return len(self._pool)
+
     def close(self) -> None:
         self._closed = True
         self._refill_wanted.set()

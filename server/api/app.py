@@ -90,8 +90,9 @@ def create_app(settings: Settings | None = None, launcher: Launcher | None = Non
         app.state.store = store
         app.state.hardware = HardwareHub(store, settings)
         app.state.hardware.start()
+        # The service listens to the hub (a run past its robot's slot is stopped); the hub
+        # knows no service.
         app.state.runs = RunService(store, settings, run_launcher, app.state.hardware)
-        app.state.hardware.runs = app.state.runs
         url = bootstrap(store, settings)
         if url:
             print(f"RoboDojo: log in as the instructor at {url}", flush=True)

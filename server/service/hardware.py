@@ -4,6 +4,7 @@ matched to their inventory entries, each with a fair queue, handed to runs as a 
     hub = HardwareHub(store, settings); hub.start()     # listens on settings.rosserial_port
     link = hub.link("crowbot-1")                         # a connected robot, or None
     hub.queue("crowbot-1").join(user_id, now)            # server/hardware/queue.py
+    hub.listen(run_service.command)                      # told when a run's slot is over
 
 A robot is matched by the address it connects from (its inventory entry's `address`, the
 CrowBot's WiFi IP): ros_lib has no authentication, so an address no entry has gets no session
@@ -12,8 +13,12 @@ robot that is in a run is refused so it cannot end that run or feed it readings 
 sees the conflict in the robot's connection state); an idle robot's reconnection replaces its
 old session (a rebooted robot comes back). A robot must offer the topics of its kind (the
 simulated robot's names and types); a mismatch is kept as a problem the instructor sees. The
-rosserial thread hands each message to the link's inbox (bounded: latest values win when a run
-is not reading).
+rosserial thread hands each message to the link's inbox (`RosserialLink`,
+server/hardware/rosserial/link.py; bounded: latest values win when a run is not reading).
+
+The hub knows no run service: when a run's time slot is over it sends a typed `Stop` to the
+listeners it was given (the run service subscribes when it is made), so neither points at the
+other.
 """
 
 from __future__ import annotations
@@ -22,77 +27,22 @@ import contextlib
 import logging
 import threading
 import time
-from collections import deque
+from collections.abc import Callable
 
 from server.hardware.queue import RobotQueue, SlotState
 from server.hardware.rosserial import Refusal, RobotConnection, RosserialHandler, RosserialServer
+from server.hardware.rosserial.link import RosserialLink
 from server.hardware.rosserial.messages import LogLevel
+from server.runs.commands import RunCommand, Stop
 from server.sim.registry import get_robot
 from server.store import robots as inventory
 from server.store.db import Store
 
 log = logging.getLogger("robodojo.hardware")
 QUEUE_TICK_S = 1.0  # [s] slots not started in time pass on, runs past their slot stop
-INBOX_MAX = 1000  # messages waiting for a run: ~10 s of the CrowBot's topics; older ones go
-LOG_LINES_KEPT = 200  # per robot, for the instructor
-
-
-class RosserialLink:
-    """A rosserial connection as a `RobotLink` (server/hardware/backend.py)."""
-
-    def __init__(self, connection: RobotConnection, name: str) -> None:
-        self.connection = connection
-        self.name = name
-        self._lost = False
-        self.lost_reason = ""
-        self._inbox: deque[tuple[str, object, float]] = deque(maxlen=INBOX_MAX)
-        self._lock = threading.Lock()
-        self.logs: deque[str] = deque(maxlen=LOG_LINES_KEPT)  # the instructor's view
-        self._new_logs: deque[str] = deque(maxlen=LOG_LINES_KEPT)  # for the run on the robot
-
-    @property
-    def connected(self) -> bool:
-        # The session closes before the hub hears of it: ask the connection itself.
-        return not self._lost and self.connection.connected
-
-    def send(self, topic: str, message: object) -> None:
-        from server.hardware.backend import RobotLost
-        from server.hardware.rosserial.session import RobotDisconnected
-
-        try:
-            self.connection.send(topic, message)
-        except RobotDisconnected:
-            self.lose("robot disconnected")
-            raise RobotLost("robot disconnected") from None
-
-    def take_received(self) -> list[tuple[str, object, float]]:
-        with self._lock:
-            taken = list(self._inbox)
-            self._inbox.clear()
-        return taken
-
-    def drain(self) -> None:
-        """Forget what arrived before a run started."""
-        with self._lock:
-            self._inbox.clear()
-
-    def log(self, line: str) -> None:
-        self.logs.append(line)
-        self._new_logs.append(line)
-
-    def take_logs(self) -> list[str]:
-        with self._lock:
-            taken = list(self._new_logs)
-            self._new_logs.clear()
-        return taken
-
-    def push(self, topic: str, message: object) -> None:
-        with self._lock:
-            self._inbox.append((topic, message, time.monotonic()))
-
-    def lose(self, reason: str) -> None:
-        self.lost_reason = reason
-        self._lost = True
+SLOT_OVER = "the robot's time slot is over"  # the reason a run past its slot stops with
+# (run_id, command): a run on a robot must be told something (server/runs/commands.py)
+RunCommandListener = Callable[[str, RunCommand], object]
 
 
 class HardwareHub(RosserialHandler):
@@ -107,7 +57,7 @@ class HardwareHub(RosserialHandler):
         self._lock = threading.Lock()
         self.server: RosserialServer | None = None
         self.listen_error = ""
-        self.runs = None  # the RunService, set by the app: the queue stops runs past their slot
+        self._listeners: list[RunCommandListener] = []  # told to stop runs past their slot
         self._closing = threading.Event()
         self._ticker = threading.Thread(target=self._tick_queues, name="robot-queues", daemon=True)
 
@@ -141,8 +91,19 @@ class HardwareHub(RosserialHandler):
                 queues = list(self._queues.values())
             for queue in queues:
                 for run_id in queue.tick(time.monotonic()):
-                    if self.runs is not None:
-                        self.runs.stop(run_id, "the robot's time slot is over")
+                    self._tell(run_id, Stop(SLOT_OVER))
+
+    def listen(self, listener: RunCommandListener) -> None:
+        """Call `listener(run_id, command)` when a run on a robot must be told something (its
+        time slot is over: a Stop). The run service listens; the hub knows no service."""
+        self._listeners.append(listener)
+
+    def _tell(self, run_id: str, command: RunCommand) -> None:
+        for listener in list(self._listeners):
+            try:
+                listener(run_id, command)
+            except Exception:  # one listener's failure must not keep the queues from ticking
+                log.exception("hardware: telling run %s to %s failed", run_id, command.op)
 
     def stop(self) -> None:
         self._closing.set()

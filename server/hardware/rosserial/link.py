@@ -1,0 +1,80 @@
+"""`RosserialLink`: a robot's rosserial connection as a `RobotLink` (server/hardware/backend.py),
+so a Run drives a CrowBot running ros_lib through `HardwareRobot("crowbot", link, limits)` as it
+drives a Create base through `CreateLink` (server/hardware/create/link.py).
+
+    link = RosserialLink(connection, "crowbot-1")    # made by the hub when the robot connects
+    link.push(topic, message)                         # the rosserial thread: what arrived
+    link.take_received()                              # the run's loop: what arrived since
+
+The rosserial thread hands each message to a bounded inbox (latest values win when no run is
+reading). `connected` asks the connection itself, since its session closes before the hub hears
+of it.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections import deque
+
+from server.hardware.backend import RobotLost
+from server.hardware.rosserial.server import RobotConnection
+from server.hardware.rosserial.session import RobotDisconnected
+
+INBOX_MAX = 1000  # messages waiting for a run: ~10 s of the CrowBot's topics; older ones go
+LOG_LINES_KEPT = 200  # per robot, for the instructor
+
+
+class RosserialLink:
+    """A rosserial connection as a `RobotLink` (server/hardware/backend.py)."""
+
+    def __init__(self, connection: RobotConnection, name: str) -> None:
+        self.connection = connection
+        self.name = name
+        self._lost = False
+        self.lost_reason = ""
+        self._inbox: deque[tuple[str, object, float]] = deque(maxlen=INBOX_MAX)
+        self._lock = threading.Lock()
+        self.logs: deque[str] = deque(maxlen=LOG_LINES_KEPT)  # the instructor's view
+        self._new_logs: deque[str] = deque(maxlen=LOG_LINES_KEPT)  # for the run on the robot
+
+    @property
+    def connected(self) -> bool:
+        # The session closes before the hub hears of it: ask the connection itself.
+        return not self._lost and self.connection.connected
+
+    def send(self, topic: str, message: object) -> None:
+        try:
+            self.connection.send(topic, message)
+        except RobotDisconnected:
+            self.lose("robot disconnected")
+            raise RobotLost("robot disconnected") from None
+
+    def take_received(self) -> list[tuple[str, object, float]]:
+        with self._lock:
+            taken = list(self._inbox)
+            self._inbox.clear()
+        return taken
+
+    def drain(self) -> None:
+        """Forget what arrived before a run started."""
+        with self._lock:
+            self._inbox.clear()
+
+    def log(self, line: str) -> None:
+        self.logs.append(line)
+        self._new_logs.append(line)
+
+    def take_logs(self) -> list[str]:
+        with self._lock:
+            taken = list(self._new_logs)
+            self._new_logs.clear()
+        return taken
+
+    def push(self, topic: str, message: object) -> None:
+        with self._lock:
+            self._inbox.append((topic, message, time.monotonic()))
+
+    def lose(self, reason: str) -> None:
+        self.lost_reason = reason
+        self._lost = True
