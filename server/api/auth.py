@@ -45,6 +45,11 @@ class Caller:
     def is_instructor(self) -> bool:
         return self.role is Role.INSTRUCTOR
 
+    @property
+    def who(self) -> str:
+        """How a stop by this caller is told in the run's reason ("stopped by the user")."""
+        return "an instructor" if self.is_instructor else "the user"
+
     def can_see(self, owner_id: str) -> bool:
         """A student sees their own things; an instructor sees everyone's."""
         return owner_id == self.id or self.is_instructor

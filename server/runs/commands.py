@@ -19,7 +19,7 @@ import dataclasses
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import ClassVar
+from typing import ClassVar, TypeVar
 
 from server.runs.faults import FaultKind
 
@@ -178,6 +178,9 @@ COMMANDS: dict[str, type[RunCommand]] = {
 SCRIPTABLE: tuple[type[RunCommand], ...] = (Button, Light, Goal, Teleop, InjectFault)
 
 
+Message = TypeVar("Message")  # a frozen dataclass with an `op` ClassVar, as the commands above
+
+
 def command_dict(command: RunCommand) -> dict[str, object]:
     """The command as plain JSON-ready data: {"op": ..., field: value, ...}."""
     fields = {f.name: getattr(command, f.name) for f in dataclasses.fields(command)}
@@ -195,6 +198,16 @@ def parse_command(data: Mapping[str, object], ignore: tuple[str, ...] = ("id",))
     cls = COMMANDS.get(op) if isinstance(op, str) else None
     if cls is None:
         raise CommandError(f"unknown op {op!r}; ops: {', '.join(COMMANDS)}")
+    return parse_fields(cls, data, ignore)
+
+
+def parse_fields(
+    cls: type[Message], data: Mapping[str, object], ignore: tuple[str, ...] = ("id",)
+) -> Message:
+    """`data` (a JSON object naming `cls.op`) as the frozen dataclass `cls`: unknown keys and
+    missing fields are refused with a sentence (CommandError), the values checked by `cls`.
+    Other typed messages (the live websocket's) are parsed with it too."""
+    op = cls.op
     names = {f.name for f in dataclasses.fields(cls)}
     unknown = sorted(str(key) for key in data if key not in names and key not in ("op", *ignore))
     if unknown:

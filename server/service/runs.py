@@ -5,6 +5,11 @@ shutdown. It knows nothing of HTTP: the API calls it, the CLI could too.
 Runs execute in-process, each `Run.execute()` on a worker thread of one pool (the executor seam:
 a distributed worker would replace `_submit`). A run's crash ends that run only: `execute()`
 never raises for what a node does, and anything else is caught here and stored as the reason.
+
+This is the one door to a running run: routes, the websocket, the 3D view and the hardware hub
+tell it things with typed commands (`command(run_id, Stop(...))`, server/runs/commands.py) and
+read it through plain snapshots (`live`, `logs`, `graph`, `lights`, `feed`); none of them holds
+the `Run`. What crosses this door is data, so a run on another process could stand behind it.
 """
 
 from __future__ import annotations
@@ -33,6 +38,7 @@ from server.runs.state import RunState
 from server.service import disk
 from server.service.catalog import ExerciseEntry
 from server.service.telemetry import RunTelemetry, TelemetryRegistry
+from server.sim.world import LightSource
 from server.store import robots as inventory
 from server.store import runs as run_store
 from server.store.db import Store
@@ -76,6 +82,18 @@ class ActiveRun:
     exercise: ExerciseEntry | None
     hardware: str | None = None  # the bench robot's name, for a hardware run
     started_wall: float = field(default_factory=time.monotonic)
+
+
+@dataclass(frozen=True, slots=True)
+class LiveRun:
+    """What a running run looks like now, read once: routes show this, never the run itself."""
+
+    run_id: str
+    state: RunState
+    time_s: float  # [s] the run's clock (simulated time for a lockstep run)
+    ros_version: int  # 1 or 2: the dialect the nodes speak
+    node_periods: dict[str, dict]  # node -> its recent loop periods (metrics.recent_summary)
+    sandbox_processes: int  # nodes with a live sandbox process
 
 
 class _Watch:
@@ -124,6 +142,8 @@ class RunService:
         self._pool = ThreadPoolExecutor(
             max_workers=settings.max_runs_total, thread_name_prefix="run"
         )
+        if hardware is not None:  # a run past its robot's time slot is told to stop
+            hardware.listen(self.command)
 
     # ------------------------------------------------------------------------------ starting
     def build_spec(self, request: RunRequest) -> RunSpec:
@@ -223,13 +243,21 @@ class RunService:
                 run_dir=str(run_dir),
                 hardware=request.hardware,
             )
-            with self.store.session() as db:
-                run_store.add(db, record)
+            # The robot is claimed before the run is stored: a refused run (not your turn, not
+            # connected) leaves no record, like any other refused request, instead of a run
+            # "created" forever in the student's history.
             backend = None
             if request.hardware is not None:
                 backend = self._claim_robot(request.hardware, user_id, run_id, spec)
+            try:
+                run = Run(spec, self.launcher, run_dir, run_id=run_id, backend=backend)
+                with self.store.session() as db:
+                    run_store.add(db, record)
+            except BaseException:
+                if request.hardware is not None:  # the robot's slot goes to the next in line
+                    self.hardware.queue(request.hardware).finish(run_id, time.monotonic())
+                raise
             telemetry = self.telemetry.create(run_id)
-            run = Run(spec, self.launcher, run_dir, run_id=run_id, backend=backend)
             run.observer = _Watch(self, run_id, telemetry)
             self._active[run_id] = ActiveRun(run, user_id, telemetry, exercise, request.hardware)
         self._pool.submit(self._execute, run_id)
@@ -258,8 +286,12 @@ class RunService:
             self.hardware.queue(name).start(user_id, run_id, time.monotonic())
         except QueueError as error:
             raise RunLimitError(str(error), self.settings.retry_after_s) from None
-        link.drain()
-        return HardwareRobot(kind, link, MotionLimits(**limits), watchdog_s)
+        try:
+            link.drain()
+            return HardwareRobot(kind, link, MotionLimits(**limits), watchdog_s)
+        except BaseException:
+            self.hardware.queue(name).finish(run_id, time.monotonic())
+            raise
 
     def command(self, run_id: str, command: RunCommand) -> bool:
         """Send a command (server/runs/commands.py) to a running run; False when it is not
@@ -329,21 +361,67 @@ class RunService:
                 {"type": "checks", "checks": json_safe(checks), "score": score}
             )
 
-    # ------------------------------------------------------------------------------ controls
-    def active(self, run_id: str) -> ActiveRun | None:
-        return self._active.get(run_id)
+    # ------------------------------------------------------------------------------ reading
+    # Whatever reads a running Run is here, and only here: callers get data, not the run.
+    def is_running(self, run_id: str) -> bool:
+        """Whether the run is still in the service (going, or being judged and stored)."""
+        return run_id in self._active
 
-    def active_runs(self) -> list[ActiveRun]:
+    def live(self, run_id: str) -> LiveRun | None:
+        """A snapshot of a running run; None when it is not running (any more)."""
+        active = self._active.get(run_id)
+        if active is None:
+            return None
+        run = active.run
+        slots = dict(run.slots)
+        return LiveRun(
+            run_id=run_id,
+            state=run.state,
+            time_s=run.time_s,
+            ros_version=run.dialect.ros_version,
+            node_periods={
+                name: slot.metrics.period.recent_summary() for name, slot in slots.items()
+            },
+            sandbox_processes=sum(1 for slot in slots.values() if slot.process is not None),
+        )
+
+    def logs(self, run_id: str) -> dict[str, list[str]] | None:
+        """What each node of a running run printed so far; None when it is not running."""
+        active = self._active.get(run_id)
+        if active is None:
+            return None
+        return {name: list(slot.logs) for name, slot in dict(active.run.slots).items()}
+
+    def graph(self, run_id: str) -> dict | None:
+        """A running run's nodes and topics with measured rates; None when it is not running."""
+        active = self._active.get(run_id)
+        return active.run.bus.graph() if active is not None else None
+
+    def lights(self, run_id: str) -> tuple[LightSource, ...] | None:
+        """Where a running run's lights are now (the simulation replaces the tuple whole when
+        one moves, so it is read safely from here); None when it is not running (or its robot
+        is not made yet)."""
+        active = self._active.get(run_id)
+        robot = active.run.sim if active is not None else None
+        return tuple(robot.lights) if robot is not None else None
+
+    def feed(self, run_id: str) -> RunTelemetry | None:
+        """A running run's telemetry, for a viewer to follow; None when it is not running."""
+        active = self._active.get(run_id)
+        return active.telemetry if active is not None else None
+
+    def _actives(self) -> list[ActiveRun]:
         with self._lock:
             return list(self._active.values())
 
+    # ------------------------------------------------------------------------------ controls
     def stop(self, run_id: str, reason: str = "stopped by the user") -> bool:
         """Ask a run to stop; False when it is not running (any more)."""
         return self.command(run_id, Stop(reason))
 
     def stop_user(self, user_id: str, reason: str) -> int:
         stopped = 0
-        for active in self.active_runs():
+        for active in self._actives():
             if active.user_id == user_id:
                 active.run.command(Stop(reason))
                 stopped += 1
@@ -362,14 +440,14 @@ class RunService:
         self._pool.shutdown(wait=False, cancel_futures=True)
 
     def status(self) -> dict:
-        actives = self.active_runs()
+        with self._lock:
+            run_ids = list(self._active)
+        lives = [live for live in map(self.live, run_ids) if live is not None]
         return {
-            "active_runs": len(actives),
-            "active_by_state": _count(str(a.run.state) for a in actives),
-            "sandbox_processes": sum(
-                1 for a in actives for slot in a.run.slots.values() if slot.process is not None
-            ),
-            "warm_pool": len(getattr(self.launcher, "_pool", ())),
+            "active_runs": len(lives),
+            "active_by_state": _count(str(live.state) for live in lives),
+            "sandbox_processes": sum(live.sandbox_processes for live in lives),
+            "warm_pool": self.launcher.warm_count,
             "max_runs_total": self.settings.max_runs_total,
             "max_runs_per_student": self.settings.max_runs_per_student,
             "live_viewers": self.telemetry.viewer_count(),

@@ -4,8 +4,8 @@ the run's thread or its simulation. Latest value wins twice over: the viewer han
 topic's newest sample at most SUBSCRIBE_HZ, and frames are drawn at most DRAW_HZ with whatever
 state has been folded in by then.
 
-The lights are the one thing telemetry does not carry: they are read from `run.sim.lights`, a
-tuple the simulation replaces whole when a light moves, so reading it from here is safe.
+The lights are the one thing telemetry does not carry: `lights()` reads them (the manager binds
+it to `RunService.lights` for this run; None once the run has ended).
 """
 
 from __future__ import annotations
@@ -13,8 +13,10 @@ from __future__ import annotations
 import asyncio
 import logging
 import time
+from collections.abc import Callable
 
 from server.service.telemetry import RunTelemetry
+from server.sim.world import LightSource
 from server.viz.view import SceneView
 from server.viz.view_state import ViewState
 
@@ -27,8 +29,13 @@ IDLE_WAIT_S = 1.0  # [s] with nothing new, wake this often to notice a stop
 SKIPPED_TOPICS = frozenset({"map"})  # the occupancy grid is drawn from the world, once
 
 
-async def follow_live(view: SceneView, telemetry: RunTelemetry, run) -> ViewState:
-    """Draw the run until its telemetry ends (returns the last state) or the task is cancelled."""
+async def follow_live(
+    view: SceneView,
+    telemetry: RunTelemetry,
+    lights: Callable[[], tuple[LightSource, ...] | None] = lambda: None,
+) -> ViewState:
+    """Draw the run until its telemetry ends (returns the last state) or the task is cancelled.
+    `lights()`: where the run's lights are now (None: unknown, the last ones drawn stay)."""
     viewer = telemetry.viewer()
     state = ViewState(lights=view.world.lights)
     subscribed: set[str] = set()
@@ -53,9 +60,9 @@ async def follow_live(view: SceneView, telemetry: RunTelemetry, run) -> ViewStat
                     state.apply(frame["topic"], frame["msg_type"], frame["time_s"], frame["msg"])
                 elif kind == "topic":
                     subscribe(frame["topic"])
-            sim = getattr(run, "sim", None)
-            if sim is not None and sim.lights != state.lights:
-                state.lights = sim.lights
+            now_lights = lights()
+            if now_lights is not None and now_lights != state.lights:
+                state.lights = now_lights
                 state.version += 1
             now_s = time.monotonic()
             if state.version != drawn_version and now_s >= next_draw_s:

@@ -1,14 +1,15 @@
 """One ViserServer per watched run, on a free loopback port, started when someone opens the run's
 view and stopped once nobody has watched it for IDLE_STOP_S.
 
-    manager = VizManager(run_service)                 # in the app's lifespan
+    manager = VizManager(run_service)                 # in the app's lifespan (LiveRuns)
     session = await manager.open(run_id, robot, world, run_dir)   # the page or its websocket
     async with manager.watching(session): ...         # while a proxied websocket is open
     await manager.close()                             # at shutdown: every server stopped
 
 A session shows an active run live (live.py) and, when it ends, replays its recording in the same
 scene (replay.py); a run that ended before anyone looked is replayed from the start; one without
-a recording shows its world and says so.
+a recording shows its world and says so. The live run is reached only through the run service
+(`LiveRuns`): its telemetry to draw, its lights, and typed commands for the view's clicks.
 
 The viser port answers anyone on this machine without asking who they are (viser has no auth):
 it is bound to 127.0.0.1 only, and the API's proxy (server/api/routes/viz.py) is the door.
@@ -18,6 +19,7 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import functools
 import logging
 import threading
 import time
@@ -25,8 +27,12 @@ from collections.abc import AsyncIterator
 from dataclasses import dataclass, field
 from enum import StrEnum
 from pathlib import Path
+from typing import Protocol
 
+from server.runs.commands import RunCommand
 from server.runs.recorder import RECORDING_FILE
+from server.service.telemetry import RunTelemetry
+from server.sim.world import LightSource
 from server.viz.live import follow_live
 from server.viz.recording import RecordingError, load_recording
 from server.viz.replay import ReplayPlayer
@@ -38,6 +44,18 @@ REAP_PERIOD_S = 5.0  # [s] how often idle views are looked for
 END_WAIT_S = 120.0  # [s] after a live run's telemetry ends, wait this long for its recording
 END_POLL_S = 0.1  # [s]
 LOOPBACK = "127.0.0.1"
+
+
+class LiveRuns(Protocol):
+    """What the views need of the run service (server/service/runs.py RunService)."""
+
+    def feed(self, run_id: str) -> RunTelemetry | None: ...
+
+    def is_running(self, run_id: str) -> bool: ...
+
+    def lights(self, run_id: str) -> tuple[LightSource, ...] | None: ...
+
+    def command(self, run_id: str, command: RunCommand) -> bool: ...
 
 
 class Mode(StrEnum):
@@ -99,7 +117,10 @@ def _quiet_viser() -> None:
 
 class VizManager:
     def __init__(
-        self, runs=None, idle_stop_s: float = IDLE_STOP_S, reap_period_s: float = REAP_PERIOD_S
+        self,
+        runs: LiveRuns | None = None,
+        idle_stop_s: float = IDLE_STOP_S,
+        reap_period_s: float = REAP_PERIOD_S,
     ) -> None:
         """`runs`: the RunService whose active runs are shown live (None: replays only)."""
         self.runs = runs
@@ -121,39 +142,39 @@ class VizManager:
         async with lock:
             session = self.sessions.get(run_id)
             if session is None:
-                active = self.runs.active(run_id) if self.runs is not None else None
+                telemetry = self.runs.feed(run_id) if self.runs is not None else None
                 session = await asyncio.to_thread(
-                    self._create, run_id, robot, world, Path(run_dir), active
+                    self._create, run_id, robot, world, Path(run_dir), telemetry is not None
                 )
                 self.sessions[run_id] = session
-                if active is not None:
-                    session.feed = asyncio.create_task(self._follow(session, active))
+                if telemetry is not None:
+                    session.feed = asyncio.create_task(self._follow(session, telemetry))
                 log.info(
                     "run %s: 3D view (%s) on %s:%d", run_id, session.mode, LOOPBACK, session.port
                 )
         session.last_seen_s = time.monotonic()
         return session
 
-    def _create(self, run_id: str, robot: str, world: str, run_dir: Path, active) -> VizSession:
+    def _create(self, run_id: str, robot: str, world: str, run_dir: Path, live: bool) -> VizSession:
         import viser
 
         server = viser.ViserServer(host=LOOPBACK, port=0, label=f"run {run_id[:12]}", verbose=False)
         try:
-            controls = active.run if active is not None else None
-            view = SceneView(server, robot, world, controls)
-            mode = Mode.LIVE if active is not None else Mode.REPLAY
-            session = VizSession(run_id, server, view, run_dir, mode)
-            if active is None:
+            send = functools.partial(self.runs.command, run_id) if live else None
+            view = SceneView(server, robot, world, send)
+            session = VizSession(run_id, server, view, run_dir, Mode.LIVE if live else Mode.REPLAY)
+            if not live:
                 session.start_replay()
             return session
         except BaseException:
             server.stop()
             raise
 
-    async def _follow(self, session: VizSession, active) -> None:
+    async def _follow(self, session: VizSession, telemetry: RunTelemetry) -> None:
         """Live until the run's telemetry ends, then (recording closed) replay."""
+        lights = functools.partial(self.runs.lights, session.run_id)
         try:
-            await follow_live(session.view, active.telemetry, active.run)
+            await follow_live(session.view, telemetry, lights)
         except asyncio.CancelledError:
             raise
         except Exception:
@@ -161,7 +182,7 @@ class VizManager:
         session.view.stop_controls()
         session.view.set_status("**ended**: loading the replay…")
         deadline = time.monotonic() + END_WAIT_S
-        while self.runs.active(session.run_id) is not None and time.monotonic() < deadline:
+        while self.runs.is_running(session.run_id) and time.monotonic() < deadline:
             await asyncio.sleep(END_POLL_S)
         await asyncio.to_thread(session.start_replay)
 

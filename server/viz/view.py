@@ -1,6 +1,8 @@
 """One run's 3D view on one ViserServer: the world, the robot, the overlays and the lights put
 together, `draw(state)` to show a `ViewState`, and the run's controls wired to the scene (a click
-on the floor of a mapped world sets the goal pose; dragging a movable light moves it).
+on the floor of a mapped world sends a `Goal`; dragging a movable light sends a `Light`: typed
+commands, server/runs/commands.py, handed to `send`, which the manager binds to
+`RunService.command` for this run).
 
 Who may use the controls is settled before anyone reaches this server: the proxy admits only the
 run's owner and instructors, the same people the run's control routes accept.
@@ -10,8 +12,9 @@ from __future__ import annotations
 
 import logging
 import math
-from typing import Protocol
+from collections.abc import Callable
 
+from server.runs.commands import Goal, Light, RunCommand
 from server.sim.registry import get_robot
 from server.sim.world import load_world
 from server.viz.lights import LightMarkers
@@ -27,12 +30,8 @@ CAMERA_BACK = 0.15  # [1] of the world's larger side: the first camera stands th
 CAMERA_UP = 1.2  # [1] of the world's larger side, this high: looking down over the walls
 
 
-class Controls(Protocol):
-    """What a live run accepts from the view (server.runs.controls.RunControls)."""
-
-    def set_goal(self, x: float, y: float, yaw: float = 0.0) -> None: ...
-
-    def move_light(self, name: str, x: float, y: float) -> None: ...
+# Sends a command to the run on show: False (or an error) when the run has ended.
+CommandSink = Callable[[RunCommand], object]
 
 
 def floor_point(origin, direction) -> tuple[float, float] | None:
@@ -49,13 +48,13 @@ def _same(old: tuple | None, new: tuple) -> bool:
 
 class SceneView:
     def __init__(
-        self, server, robot_id: str, world_id: str, controls: Controls | None = None
+        self, server, robot_id: str, world_id: str, send: CommandSink | None = None
     ) -> None:
         self.server = server
         self.robot = get_robot(robot_id)
         self.world = load_world(world_id)
         self.sensors = self.robot.build_sensors()
-        self.controls = controls
+        self.send = send  # None: a replay, or a run that has ended
         scene = server.scene
         scene.set_up_direction("+z")
         min_x, min_y, max_x, max_y = self.world.bounds
@@ -72,11 +71,11 @@ class SceneView:
             scene,
             self.world.lights,
             self.world.bounds,
-            on_move=self._move_light if controls is not None else None,
+            on_move=self._move_light if send is not None else None,
         )
         self.pose: tuple[float, float, float] | None = None
         self._reading_keys: dict[str, tuple] = {}  # topic -> reading_key last drawn
-        if controls is not None and self.world.grid_map is not None:
+        if send is not None and self.world.grid_map is not None:
             scene.on_click()(self._clicked)
         self.status = server.gui.add_markdown("")
 
@@ -109,27 +108,29 @@ class SceneView:
     # ----------------------------------------------------------------------------- controls
     def stop_controls(self) -> None:
         """The run ended: clicks and drags do nothing from now on."""
-        self.controls = None
+        self.send = None
 
     def _clicked(self, event) -> None:
-        controls = self.controls
         point = floor_point(event.ray_origin, event.ray_direction)
-        if controls is None or point is None or not self.world.in_bounds(*point):
+        if point is None or not self.world.in_bounds(*point):
             return
         x, y = point
         yaw = 0.0
         if self.pose is not None:  # face the way the robot has to go to get there
             yaw = math.atan2(y - self.pose[1], x - self.pose[0])
-        try:
-            controls.set_goal(x, y, yaw)
-        except Exception:  # a run that just ended: nothing to steer
-            log.info("goal (%.2f, %.2f) not set: the run is not running", x, y)
+        self._tell(Goal(x, y, yaw))
 
     def _move_light(self, name: str, x: float, y: float) -> None:
-        controls = self.controls
-        if controls is None:
+        self._tell(Light(x, y, name))
+
+    def _tell(self, command: RunCommand) -> None:
+        send = self.send
+        if send is None:
             return
         try:
-            controls.move_light(name, x, y)
-        except Exception:
-            log.info("light %s not moved: the run is not running", name)
+            sent = send(command)
+        except Exception as error:  # a run that just ended, or a state that refuses it
+            log.info("%s not sent: %s", command, error)
+            return
+        if sent is False:
+            log.info("%s not sent: the run is not running", command)

@@ -112,6 +112,24 @@ def test_commands_are_acked_and_reach_the_robot(lab, light_run):
     assert any(f["type"] == "log" and f["line"] == "button pressed" for f in frames)
 
 
+def test_an_emergency_stop_is_named_after_the_login_not_the_frame(lab, light_run):
+    student, run_id = light_run
+    with live(lab, student, run_id) as ws:
+        ws.send(json.dumps({"id": "w", "op": "estop", "who": "the instructor"}))
+        ws.send(json.dumps({"id": "r", "op": "stop", "reason": "stopped by an instructor"}))
+        frames = frames_for(ws, 1.0)
+        assert "it does not know who" in answer_to(frames, "w")["detail"]
+        assert "it does not know reason" in answer_to(frames, "r")["detail"]
+        assert student.get(f"/api/runs/{run_id}").json()["state"] == "running"  # not obeyed
+        ws.send(json.dumps({"id": "e", "op": "estop"}))
+        frames = []
+        while not frames or frames[-1]["type"] != "end":
+            frames.append(json.loads(ws.recv(timeout=20)))
+    assert answer_to(frames, "e") == {"type": "ack", "id": "e"}
+    run = wait_for_end(student, run_id)
+    assert run["reason"] == "interrupted: emergency stop by the user"
+
+
 def test_a_command_flood_is_refused_not_obeyed(lab, light_run):
     student, run_id = light_run
     with live(lab, student, run_id) as ws:

@@ -13,6 +13,7 @@ from types import SimpleNamespace
 
 import pytest
 
+from server.runs.commands import Goal, RunCommand
 from server.runs.run import Run
 from server.service.telemetry import RunTelemetry
 from server.viz.manager import LOOPBACK, Mode, VizManager
@@ -40,13 +41,26 @@ def port_is_free(port: int) -> bool:
 
 
 class FakeService:
-    """RunService's `active(run_id)`, for the runs a test says are going."""
+    """RunService's door for the views (manager.LiveRuns), for the runs a test says are going."""
 
     def __init__(self) -> None:
         self.running: dict[str, SimpleNamespace] = {}
+        self.sent: list[tuple[str, RunCommand]] = []
 
-    def active(self, run_id: str):
-        return self.running.get(run_id)
+    def feed(self, run_id: str):
+        active = self.running.get(run_id)
+        return active.telemetry if active is not None else None
+
+    def is_running(self, run_id: str) -> bool:
+        return run_id in self.running
+
+    def lights(self, run_id: str):
+        active = self.running.get(run_id)
+        return active.run.sim.lights if active is not None and active.run.sim else None
+
+    def command(self, run_id: str, command: RunCommand) -> bool:
+        self.sent.append((run_id, command))
+        return run_id in self.running
 
 
 def test_a_view_starts_on_demand_is_shared_and_stops_when_idle(crowbot_run):
@@ -127,13 +141,15 @@ def test_a_live_view_becomes_the_replay_when_the_run_ends(launcher, tmp_path):
     async def main() -> None:
         manager = VizManager(service)
         session = await manager.open("live", "crowbot", "light_arena", tmp_path)
-        assert session.mode is Mode.LIVE and session.view.controls is run
+        assert session.mode is Mode.LIVE and session.view.send is not None
+        session.view.send(Goal(0.5, 0.5))  # the view's clicks go to the service, typed
+        assert service.sent == [("live", Goal(0.5, 0.5))]
         worker = threading.Thread(target=execute)
         worker.start()
         await asyncio.wait_for(session.feed, timeout=30.0)
         worker.join()
         assert session.mode is Mode.REPLAY and session.player is not None
-        assert session.view.controls is None  # an ended run takes no clicks
+        assert session.view.send is None  # an ended run takes no clicks
         await manager.close()
 
     asyncio.run(main())

@@ -12,6 +12,7 @@ from types import SimpleNamespace
 import pytest
 
 from sandbox.protocol import Clock
+from server.runs.commands import Goal, Light, RunCommand
 from server.runs.recorder import RECORDING_FILE
 from server.runs.run import Run
 from server.service.telemetry import RunTelemetry
@@ -23,15 +24,24 @@ from server.viz.view_state import SensorFrame, ViewState
 from tests.viz.conftest import crowbot_spec
 
 
-class FakeControls:
+class SentCommands:
+    """The view's `send`: keeps the typed commands it is given, as RunService.command would
+    take them."""
+
     def __init__(self) -> None:
-        self.goals, self.lights = [], []
+        self.sent: list[RunCommand] = []
 
-    def set_goal(self, x, y, yaw=0.0):
-        self.goals.append((x, y, yaw))
+    def __call__(self, command: RunCommand) -> bool:
+        self.sent.append(command)
+        return True
 
-    def move_light(self, name, x, y):
-        self.lights.append((name, x, y))
+    @property
+    def goals(self) -> list[tuple[float, float, float]]:
+        return [(c.x, c.y, c.yaw) for c in self.sent if isinstance(c, Goal)]
+
+    @property
+    def lights(self) -> list[tuple[str | None, float, float]]:
+        return [(c.name, c.x, c.y) for c in self.sent if isinstance(c, Light)]
 
 
 def wait_until(predicate, timeout_s: float = 5.0) -> None:
@@ -71,7 +81,7 @@ def test_crowbot_leds_and_buzzer(viser_server):
 
 
 def test_a_click_on_the_office_floor_sets_a_goal_facing_away_from_the_robot(viser_server):
-    controls = FakeControls()
+    controls = SentCommands()
     view = SceneView(viser_server, "turtlebot", "office", controls)
     view.draw(ViewState(pose=(2.0, 1.0, 0.0)))
     click = SimpleNamespace(ray_origin=(3.0, 1.0, 4.0), ray_direction=(0.0, 0.6, -0.8))
@@ -86,7 +96,7 @@ def test_a_click_on_the_office_floor_sets_a_goal_facing_away_from_the_robot(vise
 
 
 def test_dragging_the_lamp_moves_it_within_the_arena(viser_server):
-    controls = FakeControls()
+    controls = SentCommands()
     view = SceneView(viser_server, "crowbot", "light_arena", controls)
     gizmo = viser_server.scene.get_handle_by_name("/lights/lamp")
     assert gizmo is not None and "lamp" in view.lights.nodes
@@ -127,7 +137,7 @@ def test_a_live_run_is_followed_from_its_telemetry_to_its_end(viser_server, laun
     telemetry = RunTelemetry("live")
     spec = crowbot_spec(duration_s=1.5, clock=Clock.REALTIME)  # lockstep outruns 30 Hz frames
     run = Run(spec, launcher, tmp_path / "run", observer=telemetry)
-    view = SceneView(viser_server, "crowbot", "light_arena", run)
+    view = SceneView(viser_server, "crowbot", "light_arena", run.command)
     worker = threading.Thread(target=run.execute)
 
     async def drag_the_lamp() -> None:
@@ -138,7 +148,8 @@ def test_a_live_run_is_followed_from_its_telemetry_to_its_end(viser_server, laun
 
     async def main() -> ViewState:
         worker.start()
-        feed = asyncio.create_task(follow_live(view, telemetry, run))
+        lights = lambda: run.sim.lights if run.sim is not None else None  # noqa: E731
+        feed = asyncio.create_task(follow_live(view, telemetry, lights))
         await drag_the_lamp()
         return await feed
 

@@ -10,11 +10,13 @@ Server -> client frames (JSON):
     {"type": "ack", "id"} / {"type": "error", "id", "detail"}                    answers
     {"type": "end", "state", "reason"}                                           then close
 
-Client -> server commands, each answered with an ack or an error carrying its "id":
+Client -> server commands, each answered with an ack or an error carrying its "id" (one typed
+message per op, dispatched from a table: server/api/live_ops.py):
     {"id": 1, "op": "subscribe", "topic": "Distance", "max_rate_hz": 20}
-    {"op": "unsubscribe", "topic"} / {"op": "stop"} / {"op": "pause"} / {"op": "resume"}
-    {"op": "button", "pressed": true} / {"op": "light", "x", "y", "name"?}
+    {"op": "unsubscribe", "topic"} / {"op": "stop"} / {"op": "estop"} / {"op": "pause"}
+    {"op": "resume"} / {"op": "button", "pressed": true} / {"op": "light", "x", "y", "name"?}
     {"op": "goal", "x", "y", "yaw"?} / {"op": "teleop", "key": "up", "pressed": true}
+A stop's reason and an emergency stop's "who" come from the login, never from the frame.
 
 Latest wins: a slow client gets the newest sample at its rate and a count of what it missed;
 nothing queues per client beyond one frame in flight. Someone else's run: closed with code
@@ -35,8 +37,9 @@ from fastapi import APIRouter, WebSocket, WebSocketDisconnect
 from starlette.concurrency import run_in_threadpool
 
 from server.api.auth import foreign_origin, websocket_user
+from server.api.live_ops import LiveContext, apply_live
 from server.api.sockets import REVOKED_CODE, REVOKED_REASON
-from server.runs.commands import CommandError, parse_command
+from server.runs.commands import CommandError
 from server.service.telemetry import SubscriptionError, UnknownRunError, ViewerLimitError
 from server.store import runs as run_store
 
@@ -47,19 +50,6 @@ NOT_LOGGED_IN_CODE = 4401  # websocket close code: no session cookie or token (a
 COMMANDS_PER_S = 50  # a person clicking and typing; more is a runaway client
 MAX_COMMAND_CHARS = 4096  # a command is a small JSON object
 WAIT_S = 1.0  # [s] the writer wakes at least this often to notice a closed socket
-
-
-def _apply(op: str, command: dict, viewer, service, run_id: str) -> None:
-    """Do one command; raise CommandError with a sentence when it cannot be done."""
-    if op == "subscribe":
-        viewer.subscribe(command.get("topic"), command.get("max_rate_hz", 10))
-        return
-    if op == "unsubscribe":
-        viewer.unsubscribe(command.get("topic"))
-        return
-    run_command = parse_command(command)
-    if not service.command(run_id, run_command):
-        raise CommandError(f"the run has ended; '{op}' needs a running run")
 
 
 @router.websocket("/api/runs/{run_id}/live")
@@ -110,6 +100,7 @@ async def live(websocket: WebSocket, run_id: str) -> None:
         await websocket.send_json({"type": "end", "state": record.state, "reason": record.reason})
         await websocket.close()
         return
+    context = LiveContext(caller, run_id, service, viewer)
     send_lock = asyncio.Lock()
 
     async def send(frame: dict) -> None:
@@ -140,7 +131,7 @@ async def live(websocket: WebSocket, run_id: str) -> None:
                 if not isinstance(request_id, str | int | None) or isinstance(request_id, bool):
                     request_id = None
                     raise CommandError("'id' must be a string or an integer")
-                _apply(str(command.get("op")), command, viewer, service, run_id)
+                await apply_live(command, context)
             except (CommandError, SubscriptionError, ValueError, TypeError) as error:
                 await send({"type": "error", "id": request_id, "detail": str(error)})
             else:

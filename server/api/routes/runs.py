@@ -45,7 +45,9 @@ def _live_state(state: RunState) -> str:
 
 
 def run_out(record: RunRecord, service: RunService, with_code: bool = False) -> dict:
-    active = service.active(record.id)
+    """The run as the API shows it: the stored record, with what a running run is doing now
+    (its state, time and loop periods, read through the service) while it runs."""
+    live = service.live(record.id)
     out = {
         "id": record.id,
         "user_id": record.user_id,
@@ -53,18 +55,16 @@ def run_out(record: RunRecord, service: RunService, with_code: bool = False) -> 
         "robot": record.robot,
         "world": record.world,
         "clock": record.clock,
-        "ros_version": active.run.dialect.ros_version
-        if active
-        else (record.metrics or {}).get("ros_version", 1),
+        "ros_version": live.ros_version if live else (record.metrics or {}).get("ros_version", 1),
         "duration_s": record.duration_s,
         "seed": record.seed,
         "hardware": record.hardware,
-        "state": _live_state(active.run.state) if active else record.state,
+        "state": _live_state(live.state) if live else record.state,
         "reason": record.reason,
         "created_at": iso(record.created_at),
         "started_at": iso(record.started_at),
         "ended_at": iso(record.ended_at),
-        "time_s": active.run.time_s if active else record.sim_time_s,
+        "time_s": live.time_s if live else record.sim_time_s,
         "wall_s": record.wall_s,
         "metrics": record.metrics,
         "nodes": record.nodes,
@@ -85,11 +85,8 @@ def run_out(record: RunRecord, service: RunService, with_code: bool = False) -> 
     }
     if with_code:
         out["code"] = record.code
-    if active is not None:
-        out["nodes_live"] = {
-            name: {"period": slot.metrics.period.recent_summary()}
-            for name, slot in active.run.slots.items()
-        }
+    if live is not None:
+        out["nodes_live"] = {name: {"period": period} for name, period in live.node_periods.items()}
     return out
 
 
@@ -272,6 +269,17 @@ def _command(request: Request, caller: Caller, run_id: str, command: commands.Ru
     return {"ok": True, "id": run_id, "action": command.op}
 
 
+def stop_by(caller: Caller, note: str | None = None) -> commands.Stop:
+    """The stop a caller sends: who stopped the run is the login's to say, never the client's
+    (a note the client adds comes after it)."""
+    return commands.Stop(f"stopped by {caller.who}" + (f": {note}" if note else ""))
+
+
+def emergency_stop_by(caller: Caller) -> commands.EmergencyStop:
+    """The emergency stop a caller sends, named after the login, not after what a client says."""
+    return commands.EmergencyStop(caller.who)
+
+
 @router.post("/{run_id}/stop", summary="Stop a run (the robot is commanded to stop)")
 def stop(
     run_id: str,
@@ -279,15 +287,12 @@ def stop(
     body: RunCommand | None = None,
     caller: Caller = Depends(current_user),
 ) -> dict:
-    who = "an instructor" if caller.is_instructor else "the user"
-    reason = f"stopped by {who}" + (f": {body.reason}" if body and body.reason else "")
-    return _command(request, caller, run_id, commands.Stop(reason))
+    return _command(request, caller, run_id, stop_by(caller, body.reason if body else None))
 
 
 @router.post("/{run_id}/estop", summary="Emergency stop: the robot stops now")
 def emergency_stop(run_id: str, request: Request, caller: Caller = Depends(current_user)) -> dict:
-    who = "an instructor" if caller.is_instructor else "the user"
-    return _command(request, caller, run_id, commands.EmergencyStop(who))
+    return _command(request, caller, run_id, emergency_stop_by(caller))
 
 
 @router.post("/{run_id}/pause", summary="Pause a lockstep run")
@@ -357,7 +362,7 @@ def csv_file(run_id: str, name: str, request: Request, caller: Caller = Depends(
 
 
 def _export(request: Request, record: RunRecord) -> Path:
-    if service_of(request).active(record.id) is not None:
+    if service_of(request).is_running(record.id):
         raise HTTPException(409, "the run is still going; CSV files are made when it has ended")
     recording_path = Path(record.run_dir) / RECORDING_FILE
     if not recording_path.is_file():
@@ -373,9 +378,9 @@ def _export(request: Request, record: RunRecord) -> Path:
 @router.get("/{run_id}/logs", summary="What each node printed")
 def logs(run_id: str, request: Request, caller: Caller = Depends(current_user)) -> dict:
     record = files_of(request, caller, run_id)
-    active = service_of(request).active(record.id)
-    if active is not None:
-        return {"nodes": {name: list(slot.logs) for name, slot in active.run.slots.items()}}
+    running = service_of(request).logs(record.id)
+    if running is not None:
+        return {"nodes": running}
     folder = Path(record.run_dir) / LOGS_DIR
     nodes = {}
     if folder.is_dir():
@@ -406,9 +411,9 @@ def metrics_file(run_id: str, request: Request, caller: Caller = Depends(current
 @router.get("/{run_id}/graph", summary="Nodes and topics with measured rates (rqt_graph)")
 def graph(run_id: str, request: Request, caller: Caller = Depends(current_user)) -> dict:
     record = files_of(request, caller, run_id)
-    active = service_of(request).active(record.id)
-    if active is not None:
-        return active.run.bus.graph()
+    running = service_of(request).graph(record.id)
+    if running is not None:
+        return running
     return json.loads(_run_file(record, "graph.json").read_text("utf-8"))
 
 
