@@ -1,7 +1,8 @@
 """Light sources in the scene: a glowing bulb and a point light at each, where the simulation has
 them now. A movable light (the light arena's lamp) gets a transform gizmo that slides it over the
-floor; releasing it, and every DRAG_UPDATE_S while dragging, calls `on_move(name, x, y)` (a live
-run's `Run.move_light`), clipped to the world's bounds as the simulator requires.
+floor; releasing it, and every DRAG_UPDATE_S while dragging, calls `on_move(name, x, y)` (the
+view sends the live run a `Light` command), clipped to the world's bounds as the simulator
+requires.
 """
 
 from __future__ import annotations

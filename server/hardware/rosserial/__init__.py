@@ -6,6 +6,8 @@
 - ``server``: the TCP server, one session per robot, callbacks to the rest of RoboDojo.
 - ``admission``: who gets a session (ros_lib has no authentication), back-off of refused peers.
 - ``limits``: every limit in one table. ``messages``: rosserial_msgs TopicInfo and Log.
+- ``link``: a connected robot as a run's `RobotLink` (imported from there, not here: it needs the
+  hardware backend, which this package does not).
 
 Protocol facts and their sources are in each module's docstring and shared/notes/protocols.md.
 """
