@@ -253,6 +253,9 @@ class CrowBotFirmware:
         self._last_sync_time_s = self._last_sync_receive_s = self._rt_time_s = 0.0
         self._counter = 0
         self.error: BaseException | None = None
+        # Called on the firmware thread with (topic, message, frame bytes) for every message
+        # received on a subscribed topic (the command-line mode prints them).
+        self.on_received: Callable[[str, object, int], None] | None = None
 
     # ------------------------------------------------------------------ control (any thread)
     def start(self) -> CrowBotFirmware:
@@ -494,6 +497,8 @@ class CrowBotFirmware:
             self.serial_log.append(f"{topic}: undecodable ({error})")
             return
         self.received.append((time.perf_counter(), topic, message))
+        if self.on_received is not None:
+            self.on_received(topic, message, len(payload) + 8)  # 7 header bytes + checksum
         if topic == "Control":
             self.serial_log.append(f"u={message.linear.x:.2f} w={message.angular.z:.2f}")
         try:
@@ -502,3 +507,36 @@ class CrowBotFirmware:
             self.serial_log.append(f"{topic}: {error}")
         if self.options.log_commands:
             self.loginfo(f"received {topic}")
+
+
+def main() -> None:
+    """Run the emulator as its own process (a robot to SIGSTOP, or to put in a network
+    namespace): one JSON line on stdout per command received, with its monotonic time [s] and
+    frame size [bytes]; runs until stdin closes or the process is killed."""
+    import argparse
+    import json
+    import sys
+
+    parser = argparse.ArgumentParser(description=main.__doc__)
+    parser.add_argument("host")
+    parser.add_argument("port", type=int)
+    parser.add_argument("--rate", type=float, default=20.0, help="[Hz] loop rate")
+    parser.add_argument("--reconnect", action="store_true", help="connect again after a drop")
+    args = parser.parse_args()
+    options = FirmwareOptions(rate_hz=args.rate, reconnect=args.reconnect)
+    robot = CrowBotFirmware(args.host, args.port, options)
+
+    def report(topic: str, message: object, size: int) -> None:
+        line = {"t": time.monotonic(), "topic": topic, "bytes": size}
+        if topic == "Control":
+            line["linear"] = message.linear.x  # type: ignore[attr-defined]
+        print(json.dumps(line), flush=True)
+
+    robot.on_received = report
+    with robot:
+        print(json.dumps({"t": time.monotonic(), "topic": "connected", "bytes": 0}), flush=True)
+        sys.stdin.read()  # the parent closes stdin to end us
+
+
+if __name__ == "__main__":
+    main()

@@ -486,3 +486,32 @@ def test_emulator_streams_every_15_ms(emulator):
         elapsed = time.monotonic() - started
         assert 39 * 0.015 * 0.9 <= elapsed < 3.0  # no faster than one frame per 15 ms
         assert parser.stats.bad_frames == 0
+
+
+def test_a_stalled_link_gets_the_newest_command_not_a_backlog(emulator, recorder):
+    driver = open_driver(emulator, recorder)
+    try:
+        driver.command(twist(0.1))
+        assert wait_for(lambda: emulator.left_mm_s == 100)
+        emulator.go_silent()  # the link stalls: no frames, nothing read
+        before = len(emulator.commands(oi.Opcode.DRIVE_DIRECT))
+        for step in range(1, 51):  # a controller that keeps commanding at 100 Hz
+            driver.command(twist(0.1 + 0.002 * step))
+            time.sleep(0.01)
+        assert driver.commands_waiting == 1 and driver.drives_replaced >= 48
+        emulator.speak_again()
+        assert wait_for(lambda: emulator.left_mm_s == 200)
+        # At most the one command written before the stall showed, then the newest.
+        assert len(emulator.commands(oi.Opcode.DRIVE_DIRECT)) - before <= 2
+        emulator.go_silent()
+        driver.command(twist(0.3))  # a frame came since the last write: written, then...
+        driver.command(twist(0.4))  # ...this one waits for the next frame, which never comes
+        driver.command(twist())  # a stop never waits: it replaces the held one, written now
+        assert driver.commands_waiting == 0
+        emulator.speak_again()
+        frames = driver.stats.frames
+        assert wait_for(lambda: driver.stats.frames >= frames + 3)
+        held = oi.encode_drive_direct(400.0, 400.0)[1:]
+        assert held not in emulator.commands(oi.Opcode.DRIVE_DIRECT)  # the stop replaced it
+    finally:
+        driver.close()

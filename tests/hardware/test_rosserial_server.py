@@ -332,7 +332,7 @@ def test_a_half_open_frame_is_abandoned_and_the_connection_closed() -> None:
         assert robot.state is SessionState.CLOSED and "sent nothing" in robot.session.close_reason
 
 
-def test_a_robot_that_stops_reading_gets_commands_dropped_not_buffered() -> None:
+def test_a_robot_that_stops_reading_gets_the_newest_command_not_a_backlog() -> None:
     handler = Recorder()
     with serving(handler, max_write_buffer_bytes=16 * 1024) as server:
         peer = socket.socket()
@@ -343,12 +343,24 @@ def test_a_robot_that_stops_reading_gets_commands_dropped_not_buffered() -> None
             peer.sendall(ros_lib_frame(PUBLISHER_IDS["Distance"], Int32(1).serialize()))
             assert wait_until(lambda: handler.connected)
             (robot,) = handler.connected
-            command = Twist(linear=Vector3(x=0.1))
-            for _ in range(40_000):  # ~2.2 MB of commands to a peer that never reads
-                robot.send("Control", command)
-            assert wait_until(lambda: robot.outgoing_dropped > 0, timeout_s=10.0)
+            for index in range(40_000):  # ~2.2 MB of commands to a peer that never answers
+                robot.send("Control", Twist(linear=Vector3(x=index / 40_000)))
+            assert wait_until(lambda: robot.commands_replaced >= 40_000 - 2, timeout_s=10.0)
+            assert robot.commands_waiting == 1
             transport = robot._transport
-            assert transport is None or transport.get_write_buffer_size() <= 16 * 1024 + 64
+            assert transport is not None and transport.get_write_buffer_size() == 0
+            # The peer speaks again: the newest command goes out, and nothing else did.
+            peer.sendall(ros_lib_frame(PUBLISHER_IDS["Distance"], Int32(2).serialize()))
+            assert wait_until(lambda: robot.commands_waiting == 0)
+            peer.settimeout(2.0)
+            received = bytearray()
+            while len(received) < 2 * 56:
+                received += peer.recv(4096)
+            frames = [f for f in FrameParser(4096).feed(bytes(received)) if f.topic_id == 100]
+            assert [Twist.deserialize(f.payload).linear.x for f in frames] == [
+                0.0,
+                39_999 / 40_000,
+            ]
 
 
 def test_connections_over_the_limit_are_refused() -> None:

@@ -16,6 +16,12 @@ encoders, calls `on_message(topic, message)` at `publish_rate_hz` (and at once w
 switch changes), notices silence, a robot that left Safe mode, and a command that went stale.
 Callbacks run on the reader thread: keep them short, hand work to a queue of your own.
 
+Drive commands are latest-wins: one is written when a sensor frame has arrived since the last
+one written (the robot streams every 15 ms, so a live robot takes them at once); otherwise it
+waits in a single slot, replaced by any newer command, and goes out with the next frame. A base
+whose link stalls (a WiFi-serial bridge, a stuck adapter) gets the newest command when it comes
+back, never a backlog; zero velocity (a stop) is written at once, always.
+
 Why Safe by default: in Safe mode the robot's firmware still stops the wheels and drops to
 Passive on a wheel drop, a cliff or the charger plugged in, whatever the student's controller
 says; Full mode turns all of that off (a cliff at the stairs is then the controller's problem).
@@ -146,6 +152,12 @@ class CreateDriver:
         self._bytes_received = 0
         self._oi_mode: oi.OIMode | None = None
         self._last_command_s: float | None = None  # monotonic time of the last nonzero command
+        # Latest-wins drive commands (module doc): a drive written since the last frame makes
+        # the next one wait in `_held_drive`.
+        self._drive_lock = threading.Lock()
+        self._held_drive: bytes | None = None
+        self._drive_unanswered = False
+        self.drives_replaced = 0  # drive commands a newer one replaced before they were written
 
     # --- state -------------------------------------------------------------------------------
 
@@ -293,9 +305,32 @@ class CreateDriver:
             raise
         self._drive(wheels.left_m_s, wheels.right_m_s)
 
+    @property
+    def commands_waiting(self) -> int:
+        """Drive commands held for the robot's next frame (0 or 1)."""
+        return int(self._held_drive is not None)
+
     def _drive(self, left_m_s: float, right_m_s: float) -> None:
-        self._last_command_s = time.monotonic() if (left_m_s or right_m_s) else None
-        self._write(oi.encode_drive_direct(right_m_s * 1000.0, left_m_s * 1000.0))
+        moving = bool(left_m_s or right_m_s)
+        self._last_command_s = time.monotonic() if moving else None
+        frame = oi.encode_drive_direct(right_m_s * 1000.0, left_m_s * 1000.0)
+        with self._drive_lock:
+            if moving and self._drive_unanswered:
+                if self._held_drive is not None:
+                    self.drives_replaced += 1
+                self._held_drive = frame
+                return
+            self._held_drive = None  # older than this one (a stop goes out at once)
+            self._drive_unanswered = True
+            self._write(frame)
+
+    def _release_drive(self) -> None:
+        """A frame arrived: the robot's link moves; write the command that waited, if any."""
+        with self._drive_lock:
+            held, self._held_drive = self._held_drive, None
+            self._drive_unanswered = held is not None
+            if held is not None:
+                self._write(held)
 
     def rearm(self) -> None:
         """Send Safe (or Full) again, after the robot dropped to Passive on a wheel drop, a
@@ -364,6 +399,10 @@ class CreateDriver:
                 if frames:
                     last_frame_s = now_s
                     self._on_frames(frames, now_s)
+                    try:
+                        self._release_drive()
+                    except CreatePortError as exc:
+                        self._on_port_failure(str(exc))
             self._check_silence(now_s - last_frame_s)
             self._check_latch(now_s)
 

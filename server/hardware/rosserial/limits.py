@@ -61,8 +61,9 @@ DEFAULT_LIMITS = RosserialLimits(
     # [frames/s] topic data frames beyond this, within one second, are dropped and counted. A
     # CrowBot at 20 Hz sends 80 (4 topics); 1000 admits a 100 Hz loop with room to spare.
     max_frames_per_s=1000,
-    # [bytes] unsent data queued for a robot that does not read (half-open link). Past this,
-    # commands are dropped and counted: a stale Control is worse than none.
+    # [bytes] unsent data queued for a robot that does not read (half-open link). Commands wait
+    # (latest wins, server.py) while anything is unsent; past this even a stop is dropped and
+    # counted: a stale Control is worse than none.
     max_write_buffer_bytes=16 * 1024,
     # [bytes] the kernel's send buffer per robot (SO_SNDBUF; Linux doubles it). Without it Linux
     # grows the buffer to megabytes on a fast link, where a stalled robot's commands would queue

@@ -25,6 +25,16 @@ once a minute per address and backed off when it keeps connecting. Connections t
 the handshake within ``handshake_timeout_s`` are closed, and at most ``max_pending_per_address``
 handshakes run per address (the newest wins: a rebooted robot's connection is the live one).
 
+Commands are latest-wins (a stale Control is worse than none): a command frame is written when
+the robot has sent anything since the last frame written on that topic, and the socket has taken
+everything written before; otherwise it waits in a one-per-topic slot, where a newer command
+replaces it, and goes out the moment the robot is heard again. A live robot publishes every loop,
+so commands flow at its loop rate; a robot that froze (stalled firmware, WiFi stuck) without
+closing its socket has at most one command per topic written after its last frame, and gets the
+newest when it resumes, never a backlog. A robot that advertises no publisher gives no sign of
+life, so only the socket bound holds for it. A stop (a zero Twist, or ``send(..., urgent=True)``)
+never waits.
+
 Unlike rosserial_python (one connection at a time unless forking) it serves up to
 ``max_connections`` robots at once; it requests topics at once instead of after 2 s (that sleep
 waits for an Arduino to reboot when its serial port opens; a TCP client is already running).
@@ -43,6 +53,7 @@ from collections import Counter
 from collections.abc import Callable
 
 from sandbox.msgs import Message
+from sandbox.msgs.geometry_msgs import Twist
 from server.hardware.rosserial.admission import AdmissionControl, Refusal
 from server.hardware.rosserial.limits import DEFAULT_LIMITS, RosserialLimits
 from server.hardware.rosserial.messages import LogLevel
@@ -115,9 +126,14 @@ class RobotConnection:
         self.connected_at = time.time()  # [s] epoch
         self.started_s = time.monotonic()  # [s] for the handshake timeout
         self.announced = False  # on_robot_connected has been called
-        self.outgoing_dropped = 0  # frames not written: the robot stopped reading
+        self.outgoing_dropped = 0  # urgent frames not written: the robot stopped reading
+        self.commands_replaced = 0  # commands a newer one replaced before they were written
         self.reads_paused = 0  # times reading paused for the rest of a second (max_bytes_per_s)
+        self.last_heard_s: float | None = None  # [s] monotonic, the robot's latest bytes
         self._transport: asyncio.Transport | None = None
+        # Latest-wins outgoing commands (module docstring); rosserial thread only.
+        self._held: dict[str, bytes] = {}  # topic -> newest frame not yet written
+        self._unanswered: set[str] = set()  # topics written since the robot was last heard
 
     @property
     def state(self) -> SessionState:
@@ -147,14 +163,23 @@ class RobotConnection:
         """Incoming frames dropped, by reason."""
         return self.session.drops
 
-    def send(self, topic: str, message: Message) -> None:
+    def send(self, topic: str, message: Message, *, urgent: bool | None = None) -> None:
         """Send `message` on a topic the robot subscribes to; any thread.
 
         Raises TopicError or RobotDisconnected (a SessionError) at once, in the caller's thread;
-        the frame is written on the rosserial thread (dropped and counted in
-        ``outgoing_dropped`` when the robot has not read the last ~16 KiB)."""
+        the frame is written on the rosserial thread, latest-wins (module docstring): it may wait
+        for the robot's next frame, replaced by a newer command on the same topic. `urgent` (a
+        stop; by default a zero geometry_msgs/Twist) is written at once unless the robot has not
+        read the last ~16 KiB (then dropped and counted in ``outgoing_dropped``)."""
         frame = self.session.encode(topic, message)
-        self._server._call_on_loop(self._write_frame, frame)
+        if urgent is None:
+            urgent = _is_stop(message)
+        self._server._call_on_loop(self._offer, topic, frame, urgent)
+
+    @property
+    def commands_waiting(self) -> int:
+        """Commands held for the robot's next frame (at most one per topic)."""
+        return len(self._held)
 
     def stop(self) -> None:
         """Send the tx-stop frame and close the connection; any thread."""
@@ -164,15 +189,48 @@ class RobotConnection:
         return f"RobotConnection({self.id}, {self.peer[0]}:{self.peer[1]}, {self.state})"
 
     # --------------------------------------------------------------- rosserial thread only
-    def _write_frame(self, frame: bytes) -> None:
+    def _offer(self, topic: str, frame: bytes, urgent: bool) -> None:
+        """Write a command now, or hold it as its topic's newest (module docstring)."""
         transport = self._transport
         if transport is None or transport.is_closing():
             return
+        if urgent or self._may_write(topic):
+            self._held.pop(topic, None)  # older than this one
+            self._write_command(topic, frame)
+            return
+        if topic in self._held:
+            self.commands_replaced += 1
+        self._held[topic] = frame
+
+    def _may_write(self, topic: str) -> bool:
+        transport = self._transport
+        if transport is None or transport.is_closing():
+            return False
+        if transport.get_write_buffer_size() > 0:
+            return False  # the socket has not taken what was written before
+        # A robot that publishes nothing gives no sign of life to wait for.
+        return not (self.session.publishers and topic in self._unanswered)
+
+    def _write_command(self, topic: str, frame: bytes) -> None:
+        transport = self._transport
+        assert transport is not None
         if transport.get_write_buffer_size() > self._server.limits.max_write_buffer_bytes:
             self.outgoing_dropped += 1
             return
         self.session.queue_frame(frame)
+        self._unanswered.add(topic)
         self._flush()
+
+    def _heard(self, now_s: float) -> None:
+        """The robot sent bytes: it is alive and reading, one more command per topic may go."""
+        self.last_heard_s = now_s
+        self._unanswered.clear()
+
+    def _release(self) -> None:
+        """Write the held commands that may go now."""
+        for topic in list(self._held):
+            if self._may_write(topic):
+                self._write_command(topic, self._held.pop(topic))
 
     def _stop(self) -> None:
         self._server._dispatch(self, self.session.stop())
@@ -182,6 +240,11 @@ class RobotConnection:
         transport = self._transport
         if data and transport is not None and not transport.is_closing():
             transport.write(data)
+
+
+def _is_stop(message: Message) -> bool:
+    """A zero velocity: stopping must not wait for the robot's next frame."""
+    return isinstance(message, Twist) and message == Twist()
 
 
 class _Connection(asyncio.BufferedProtocol):
@@ -236,8 +299,10 @@ class _Connection(asyncio.BufferedProtocol):
             return
         now_s = time.monotonic()
         self._limit_rate(now_s, nbytes)
+        robot._heard(now_s)  # before the handlers: their answers to these frames go at once
         events = robot.session.receive_data(memoryview(self._buffer)[:nbytes], now_s)
         self._server._dispatch(robot, events)
+        robot._release()  # what still waits from before these frames
 
     def _limit_rate(self, now_s: float, nbytes: int) -> None:
         """Past max_bytes_per_s, stop reading until the second is over (TCP pushes back)."""
@@ -437,6 +502,7 @@ class RosserialServer:
         limit_s = self.limits.handshake_timeout_s
         for robot in list(self._robots.values()):
             self._dispatch(robot, robot.session.poll(now_s))
+            robot._release()  # commands that waited only for the socket to drain
             if not robot.announced and robot.connected and now_s - robot.started_s > limit_s:
                 self._dispatch(
                     robot,
