@@ -11,6 +11,7 @@ do not wait for a writer, and a busy timeout so two writers queue instead of fai
 from __future__ import annotations
 
 import contextlib
+import os
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -83,6 +84,20 @@ def migrate(engine: Engine) -> None:
         command.upgrade(config, "head")
 
 
+def _sqlite_problem(database: str, reason: object) -> str:
+    """A SQLite file that cannot be opened: say so, and when its folder is not writable by us
+    (the usual cause: a bind-mounted or root-owned data folder), say how to fix that."""
+    folder = Path(database).parent
+    problem = f"cannot open the SQLite database {database}: {reason}."
+    if folder.is_dir() and os.access(folder, os.W_OK | os.X_OK):
+        return problem
+    uid, gid = os.getuid(), os.getgid()
+    return (
+        f"{problem} The folder {folder} must exist and be writable by this user (uid {uid}): "
+        f"`chown {uid}:{gid} {folder}`, or choose another folder with --data (ROBODOJO_DATA)."
+    )
+
+
 class Store:
     def __init__(self, engine: Engine) -> None:
         self.engine = engine
@@ -90,14 +105,20 @@ class Store:
 
     @classmethod
     def open(cls, url: str) -> Store:
-        engine = create(url)
+        engine = None
         try:
+            engine = create(url)
             migrate(engine)
-        except OperationalError as error:
-            engine.dispose()
-            where = make_url(normalise_url(url)).render_as_string(hide_password=True)
+        except (OperationalError, OSError) as error:
+            if engine is not None:
+                engine.dispose()
+            reason = getattr(error, "orig", None) or error
+            parsed = make_url(normalise_url(url))
+            if parsed.get_backend_name() == "sqlite":
+                raise StoreError(_sqlite_problem(parsed.database or "", reason)) from None
+            where = parsed.render_as_string(hide_password=True)
             raise StoreError(
-                f"cannot open the database at {where}: {error.orig}. Check that the server "
+                f"cannot open the database at {where}: {reason}. Check that the server "
                 "runs and the URL (user, password, host, port, database) is right."
             ) from None
         return cls(engine)

@@ -3,6 +3,7 @@ runs and their restart handling."""
 
 from __future__ import annotations
 
+import os
 import time
 
 import pytest
@@ -170,3 +171,17 @@ def test_a_session_rolls_back_on_error(store):
 def test_a_bad_database_url_is_a_sentence(url, words):
     with pytest.raises(StoreError, match=words):
         Store.open(url)
+
+
+def test_a_sqlite_folder_that_cannot_be_written_names_the_folder_not_the_url(tmp_path):
+    # A data folder that cannot be made (its parent is a file): the sentence is about the
+    # folder and its owner, never the PostgreSQL advice about users, hosts and ports.
+    blocker = tmp_path / "not-a-folder"
+    blocker.write_text("")
+    folder = blocker / "data"
+    with pytest.raises(StoreError) as raised:
+        Store.open(f"sqlite:///{folder / 'robodojo.db'}")
+    message = str(raised.value)
+    assert f"The folder {folder} must exist and be writable" in message
+    assert f"chown {os.getuid()}:{os.getgid()}" in message
+    assert "user, password" not in message
