@@ -283,11 +283,22 @@ def detect(environ: Mapping[str, str] = os.environ) -> Cgroups | CgroupsV2 | Non
         return _fall_back(f"cannot read /proc/self: {error}")
 
 
+def in_container() -> bool:
+    """Docker and podman mark their containers with these files."""
+    return os.path.exists("/.dockerenv") or os.path.exists("/run/.containerenv")
+
+
 def _fall_back(problem: str) -> None:
+    where = (
+        "give the container a delegated cgroup v2 directory writable by the server's user "
+        "and name it in %s (docker/README.md, 'Node limits')"
+        if in_container()
+        else "run the server as a systemd unit with Delegate=yes, or set %s to a writable "
+        "cgroup v2 directory whose cgroup.controllers lists memory and pids"
+    )
     log.warning(
         "%s: nodes run with rlimits only (no real memory, process-count or CPU cap). To enforce "
-        "them, run the server as a systemd unit with Delegate=yes, or set %s to a writable "
-        "cgroup v2 directory whose cgroup.controllers lists memory and pids.",
+        f"them, {where}.",
         problem,
         ROOT_ENV,
     )

@@ -94,7 +94,10 @@ def test_configured_root_is_used_and_the_hierarchy_root_keeps_its_processes(tmp_
 
 
 @pytest.mark.parametrize("controllers", ["cpu pids", "cpu memory", ""])
-def test_missing_controller_falls_back_to_rlimits_with_one_warning(tmp_path, caplog, controllers):
+def test_missing_controller_falls_back_to_rlimits_with_one_warning(
+    tmp_path, caplog, monkeypatch, controllers
+):
+    monkeypatch.setattr(cgroups, "in_container", lambda: False)
     root = fake_cgroup(tmp_path / "robodojo", controllers, procs="4242\n")
     with caplog.at_level(logging.WARNING, logger="sandbox.cgroups"):
         assert detect({ROOT_ENV: str(root)}) is None
@@ -112,3 +115,15 @@ def test_no_cgroup2_mount_falls_back(caplog):
     with caplog.at_level(logging.WARNING, logger="sandbox.cgroups"):
         assert detect_v2(MOUNTINFO.splitlines()[0], PROC_CGROUP) is None
     assert "no cgroup2 filesystem" in caplog.records[0].getMessage()
+
+
+def test_in_a_container_the_warning_points_at_the_container_docs(tmp_path, caplog, monkeypatch):
+    # systemd's Delegate=yes means nothing inside a container: the advice names what to give it.
+    monkeypatch.setattr(cgroups, "in_container", lambda: True)
+    root = fake_cgroup(tmp_path / "robodojo", "cpu", procs="")
+    with caplog.at_level(logging.WARNING, logger="sandbox.cgroups"):
+        assert detect({ROOT_ENV: str(root)}) is None
+    [record] = caplog.records
+    message = record.getMessage()
+    assert "rlimits only" in message and "docker/README.md" in message and ROOT_ENV in message
+    assert "Delegate=yes" not in message
