@@ -150,8 +150,7 @@ class Simulation:
             self.seed = seed
         spawn = self._spawn_pose(self._spawn)
         self.state = RobotState(pose=spawn, odometry_pose=Pose2D(0.0, 0.0, 0.0))
-        # A copy: `spawn` becomes the state's pose, which the physics moves in place.
-        self._odom_origin = Pose2D(spawn.x, spawn.y, spawn.yaw)
+        self._odom_origin = spawn  # frozen: the physics replaces the state's pose, never moves it
         self.lights = self.world.lights
         self.motors = self.robot.build_motors()
         self.motors.reset()
@@ -179,7 +178,7 @@ class Simulation:
 
     def _spawn_pose(self, spawn: str | Pose2D | None) -> Pose2D:
         if isinstance(spawn, Pose2D):
-            return Pose2D(spawn.x, spawn.y, spawn.yaw)
+            return spawn
         try:
             chosen = self.world.spawn(spawn or None)
         except WorldError as error:
@@ -305,7 +304,7 @@ class Simulation:
         x, y, yaw = integrate_arc(pose.x, pose.y, pose.yaw, linear, angular, dt)
         x, y = self._resolve_contacts(pose.x, pose.y, pose.yaw, x, y, yaw)
         state.distance_travelled_m += math.hypot(x - pose.x, y - pose.y)
-        pose.x, pose.y, pose.yaw = x, y, yaw
+        state.pose = Pose2D(x, y, yaw)
         state.linear_m_s, state.angular_rad_s = linear, angular
         state.wheel_left_rad_s, state.wheel_right_rad_s = left, right
         state.wheel_left_travel_rad += left * dt
@@ -315,7 +314,7 @@ class Simulation:
             left * self._odom_left_scale, right * self._odom_right_scale, wheel_radius, track
         )
         odom = state.odometry_pose
-        odom.x, odom.y, odom.yaw = integrate_arc(odom.x, odom.y, odom.yaw, odom_v, odom_w, dt)
+        state.odometry_pose = Pose2D(*integrate_arc(odom.x, odom.y, odom.yaw, odom_v, odom_w, dt))
         self._now_ns += self._tick_ns
         self.robot.advance(state, dt, self._now_ns / NS_PER_S)
         if self._out_of_bounds or not self.world.in_bounds(x, y):
@@ -402,7 +401,7 @@ class Simulation:
             time_s=self.time_s,
             robot_id=self.robot.id,
             world_id=self.world.id,
-            pose=Pose2D(state.pose.x, state.pose.y, state.pose.yaw),
+            pose=state.pose,  # frozen, so the scene keeps this instant's pose
             leds_rgb=state.leds_rgb,
             buzzer_on=state.buzzer_on,
             servo_angle_deg=state.servo_angle_deg,

@@ -2,6 +2,10 @@
 
 Plain dataclasses, no behaviour: the physics step (`server.sim.simulation`) owns and mutates one
 `RobotState`; sensors only read it. Units are SI unless a field name says otherwise.
+
+A `Pose2D` is frozen: the physics replaces `state.pose` each tick rather than moving it in place,
+so `sim.state.pose.x = 1.0` fails at once instead of teleporting the robot, and a pose someone
+kept (a spawn, an odometry origin, a scene) never changes under them.
 """
 
 from __future__ import annotations
@@ -9,7 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 
-@dataclass(slots=True)
+@dataclass(frozen=True, slots=True)
 class Pose2D:
     """A planar pose in the world frame: x, y [m], yaw [rad], counter-clockwise from +x."""
 
