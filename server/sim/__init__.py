@@ -5,6 +5,7 @@
 """
 
 from server.sim.backend import RobotBackend, WorldView
+from server.sim.checks import DefinitionError, check_robot, check_world
 from server.sim.registry import get_robot, robot_ids, robots_for_world
 from server.sim.robots.base import Direction, TopicSpec
 from server.sim.simulation import EventKind, Published, Scene, SimEvent, Simulation, SimulationError
@@ -12,6 +13,7 @@ from server.sim.state import Pose2D, RobotState
 from server.sim.world import load_world, world_ids
 
 __all__ = [
+    "DefinitionError",
     "Direction",
     "EventKind",
     "Pose2D",
@@ -24,6 +26,8 @@ __all__ = [
     "SimulationError",
     "TopicSpec",
     "WorldView",
+    "check_robot",
+    "check_world",
     "get_robot",
     "load_world",
     "robot_ids",

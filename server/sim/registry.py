@@ -1,9 +1,10 @@
 """Robots by id. Worlds have their own registry in server.sim.world; this module joins the two
-(which robot makes sense in which world, as the worlds declare)."""
+(which robot makes sense in which world, as the worlds declare). `server.sim.checks` validates
+every entry of both."""
 
 from __future__ import annotations
 
-from server.sim.robots.base import RobotModel, validate_robot
+from server.sim.robots.base import RobotModel
 from server.sim.robots.crop_rover import CropRover
 from server.sim.robots.crowbot import CrowBot
 from server.sim.robots.ir_scout import IrScout
@@ -37,17 +38,3 @@ def get_robot(robot_id: str) -> RobotModel:
 def robots_for_world(robot_id: str) -> tuple[str, ...]:
     """Ids of the worlds that declare they suit `robot_id`."""
     return tuple(w for w in world_ids() if robot_id in load_world(w).robots)
-
-
-def validate_registry() -> list[str]:
-    """Problems across all robots and worlds, as sentences."""
-    problems: list[str] = []
-    for robot_id in robot_ids():
-        problems.extend(validate_robot(get_robot(robot_id)))
-        if not robots_for_world(robot_id):
-            problems.append(f"robot '{robot_id}' has no world to drive in")
-    for world_id in world_ids():
-        for robot_id in load_world(world_id).robots:
-            if robot_id not in _ROBOTS:
-                problems.append(f"world '{world_id}' names unknown robot '{robot_id}'")
-    return problems

@@ -2,8 +2,9 @@
 
 A world is `server/sim/worlds/<id>.toml` (the format and its checks live in
 `server.sim.world_file`). `load_world(id)` reads, checks and compiles it once and caches the
-immutable `World` (its arrays are read-only, so runs can share it). `check_world` is the validator
-the tests run over every registered world. Pure: the only I/O is reading the packaged world files.
+immutable `World` (its arrays are read-only, so runs can share it);
+`server.sim.checks.check_world` is the validator the tests run over every registered world.
+Pure: the only I/O is reading the packaged world files.
 """
 
 from __future__ import annotations
@@ -34,7 +35,6 @@ __all__ = [
     "Spawn",
     "World",
     "WorldError",
-    "check_world",
     "load_world",
     "load_world_file",
     "parse_world",
@@ -317,55 +317,3 @@ def load_world(world_id: str) -> World:
         raise WorldError(f"unknown world {world_id!r} (valid ids: {', '.join(valid)})")
     resource = resources.files(_WORLDS_PACKAGE).joinpath(f"{world_id}.toml")
     return _parse_toml(resource.read_bytes(), f"{world_id}.toml")
-
-
-def check_world(world: World, robot_radius: float = 0.1) -> None:
-    """The registry's validator: raise `WorldError` listing every broken invariant of `world`.
-
-    Arrays have their documented shapes and are finite; heights, widths and radii are positive;
-    spawns, lights and tape lie inside the bounds; every spawn leaves `robot_radius` [m] of
-    clearance; robots are known; a map's data matches its width and height.
-    """
-    problems = []
-    shapes = {
-        "segments": (world.segments, 4),
-        "circles": (world.circles, 3),
-        "tape_segments": (world.tape_segments, 4),
-        "boxes": (world.boxes, 6),
-    }
-    for name, (array, columns) in shapes.items():
-        if array.ndim != 2 or array.shape[1] != columns or not np.isfinite(array).all():
-            problems.append(f"{name} must be a finite (N, {columns}) array, got {array.shape}")
-    per_row = {
-        "segment_height": len(world.segments),
-        "circle_height": len(world.circles),
-        "tape_width": len(world.tape_segments),
-        "tape_darkness": len(world.tape_segments),
-    }
-    for name, rows in per_row.items():
-        values = getattr(world, name)
-        if values.shape != (rows,) or not np.isfinite(values).all():
-            problems.append(f"{name} must be a finite ({rows},) array, got {values.shape}")
-    if (world.segment_height <= 0).any() or (world.circles[:, 2] <= 0).any():
-        problems.append("every segment height and circle radius must be > 0")
-    if world.circle_kind and len(world.circle_kind) != len(world.circles):
-        problems.append("circle_kind must name one kind per circle")
-    for spawn in world.spawns:
-        if not world.in_bounds(spawn.x, spawn.y):
-            problems.append(f"spawn {spawn.name!r} is outside the bounds")
-        elif (gap := world.clearance(spawn.x, spawn.y)) < robot_radius:
-            problems.append(
-                f"spawn {spawn.name!r} has {gap:.3f} m clearance, less than {robot_radius} m"
-            )
-    for light in world.lights:
-        if not world.in_bounds(light.x, light.y):
-            problems.append(f"light {light.name!r} is outside the bounds")
-    ends = world.tape_segments.reshape(-1, 2)
-    if not all(world.in_bounds(x, y) for x, y in ends):
-        problems.append("tape leaves the bounds")
-    problems += [f"unknown robot id {r!r}" for r in world.robots if r not in KNOWN_ROBOT_IDS]
-    grid = world.grid_map
-    if grid is not None and grid.data.shape != (grid.height, grid.width):
-        problems.append(f"grid_map.data shape {grid.data.shape} != ({grid.height}, {grid.width})")
-    if problems:
-        raise WorldError(f"world {world.id!r}: " + "; ".join(problems))

@@ -8,7 +8,8 @@ import pytest
 from sandbox.msgs.geometry_msgs import Twist, Vector3
 from sandbox.msgs.std_msgs import Bool, Float32, Int16, Int32, Int32MultiArray, String
 from server.sim import EventKind, Pose2D, Simulation, SimulationError
-from server.sim.registry import UnknownRobotError, robot_ids, validate_registry
+from server.sim.checks import registry_problems
+from server.sim.registry import UnknownRobotError, robot_ids
 from server.sim.world import WorldError
 
 
@@ -233,7 +234,7 @@ def test_bad_step_seed_and_spawn_arguments():
 
 
 def test_registry_entries_are_valid():
-    assert validate_registry() == []
+    assert registry_problems() == []
     assert robot_ids() == ("crop_rover", "crowbot", "ir_scout", "turtlebot", "turtlebot3")
 
 

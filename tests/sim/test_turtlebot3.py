@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 from sandbox.msgs.geometry_msgs import Twist, Vector3
+from server.sim.checks import robot_problems
 from server.sim.motors import TB3_UNITS_PER_RAD_S, dynamixel_units
 from server.sim.registry import get_robot, robots_for_world
-from server.sim.robots.base import validate_robot
 from server.sim.robots.turtlebot3 import MAX_ANGULAR_RAD_S, MAX_LINEAR_M_S
 from server.sim.sensors.lds01 import (
     NEAR_PRECISION_M,
@@ -214,7 +214,7 @@ def test_the_body_is_behind_the_axle_so_the_nose_gets_close_to_a_wall() -> None:
 
 def test_the_registry_entry_is_valid_and_the_worlds_take_it() -> None:
     robot = get_robot("turtlebot3")
-    assert validate_robot(robot) == []
+    assert robot_problems(robot) == []
     assert set(robots_for_world("turtlebot3")) == {
         "crop_rows",
         "obstacle_maze",
@@ -229,8 +229,8 @@ def test_a_body_offset_outside_the_body_is_refused() -> None:
     robot = get_robot("turtlebot3")
     broken = dataclasses.replace(robot.geometry, body_offset_x_m=0.2)
     robot.geometry = broken  # on this instance only
-    assert any("body_offset_x_m" in problem for problem in validate_robot(robot))
-    assert validate_robot(get_robot("turtlebot3")) == []
+    assert any("body_offset_x_m" in problem for problem in robot_problems(robot))
+    assert robot_problems(get_robot("turtlebot3")) == []
 
 
 @pytest.mark.parametrize("world_id", robots_for_world("turtlebot3"))

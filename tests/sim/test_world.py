@@ -11,12 +11,12 @@ from importlib import resources
 import numpy as np
 import pytest
 
+from server.sim.checks import check_world
 from server.sim.world import (
     KNOWN_ROBOT_IDS,
     GridMap,
     World,
     WorldError,
-    check_world,
     load_world,
     parse_world,
     rasterize,
@@ -24,7 +24,6 @@ from server.sim.world import (
 )
 
 WORLD_IDS = ("crop_rows", "light_arena", "line_track", "obstacle_maze", "office", "wall_approach")
-LARGE_ROBOTS = {"turtlebot", "crop_rover", "turtlebot3"}  # 0.11-0.2 m radius; others ~0.06 m
 
 
 def _file_data(world_id: str) -> dict:
@@ -41,7 +40,7 @@ def test_world_loads_and_holds_its_invariants(world_id: str) -> None:
     world = load_world(world_id)
     assert world.id == world_id == _file_data(world_id)["id"]
     assert load_world(world_id) is world  # cached
-    check_world(world, robot_radius=0.2 if LARGE_ROBOTS & set(world.robots) else 0.1)
+    check_world(world)
     assert world.segments.ndim == 2 and world.segments.shape[1] == 4
     assert np.isfinite(world.segments).all() and np.isfinite(world.circles).all()
     assert set(world.robots) <= set(KNOWN_ROBOT_IDS) and world.robots
@@ -75,7 +74,7 @@ def test_validator_refuses_a_spawn_inside_a_box() -> None:
     data["spawns"][0].update(x=box["x"], y=box["y"])
     world = parse_world(data, "obstacle_maze.toml")
     assert world.clearance(box["x"], box["y"]) < 0
-    with pytest.raises(WorldError, match=r"spawn 'start' has -0\.1"):
+    with pytest.raises(WorldError, match=r"spawn 'start' leaves -0\.1"):
         check_world(world)
 
 

@@ -1,13 +1,12 @@
 """What a robot is to the simulator: a registry entry that declares its topics, geometry and
 limits, builds its sensors and motor model, and turns command messages into motor commands.
 
-Each robot module defines one `RobotModel` subclass; `server.sim.robots` registers them by id and
-`validate_robot` checks every entry (the tests run it over the whole registry).
+Each robot module defines one `RobotModel` subclass; `server.sim.registry` registers them by id
+and `server.sim.checks.check_robot` checks every entry (the tests run it over the whole registry).
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from enum import StrEnum
 from typing import ClassVar, Protocol
@@ -141,43 +140,3 @@ def clamp_twist(
         max(-limits.max_linear_m_s, min(limits.max_linear_m_s, linear_m_s)),
         max(-limits.max_angular_rad_s, min(limits.max_angular_rad_s, angular_rad_s)),
     )
-
-
-def validate_robot(robot: RobotModel) -> list[str]:
-    """Problems with a registry entry, as sentences (empty when the entry is sound)."""
-    problems: list[str] = []
-    g = robot.geometry
-    for name in ("body_radius_m", "wheel_radius_m", "track_m", "length_m", "width_m", "height_m"):
-        value = getattr(g, name)
-        if not (math.isfinite(value) and value > 0):
-            problems.append(
-                f"robot '{robot.id}': geometry.{name} must be a positive size, got {value}"
-            )
-    if not (math.isfinite(g.body_offset_x_m) and abs(g.body_offset_x_m) < g.body_radius_m):
-        problems.append(
-            f"robot '{robot.id}': geometry.body_offset_x_m must put the wheel axle inside the "
-            f"body (|offset| < body_radius_m), got {g.body_offset_x_m}"
-        )
-    sensors = robot.build_sensors()
-    if not sensors:
-        problems.append(f"robot '{robot.id}': publishes no sensor topics")
-    for name, sensor in sensors.items():
-        if not (sensor.rate_hz > 0 and math.isfinite(sensor.rate_hz)):
-            problems.append(f"robot '{robot.id}': topic '{name}' has rate {sensor.rate_hz} Hz")
-        if not getattr(sensor.msg_type, "_type", None):
-            problems.append(f"robot '{robot.id}': topic '{name}' type is not a ROS message class")
-        if not robot.sensor_descriptions.get(name):
-            problems.append(f"robot '{robot.id}': topic '{name}' has no description")
-    overlap = set(sensors) & set(robot.commands)
-    if overlap:
-        problems.append(
-            f"robot '{robot.id}': topics both published and subscribed: {sorted(overlap)}"
-        )
-    if not robot.commands:
-        problems.append(f"robot '{robot.id}': subscribes to no command topics")
-    for name, (msg_type, description) in robot.commands.items():
-        if not getattr(msg_type, "_type", None) or not description:
-            problems.append(
-                f"robot '{robot.id}': command '{name}' needs a message class and a description"
-            )
-    return problems
