@@ -32,7 +32,7 @@ from sandbox.msgs.std_msgs import Header
 from server.sim.geometry import yaw_quaternion
 
 if TYPE_CHECKING:
-    from server.runs.run import Run
+    from server.runs.core import RunCore as Run  # built-ins are handed the run's core
 
 LOCALIZATION_RATE_HZ = 20.0  # [Hz] as a Nav2 AMCL pose arrives
 DEFAULT_TOLERANCE_M = 0.25  # [m] a waypoint counts as reached this close

@@ -1,7 +1,7 @@
 """How a run hosts its built-in nodes (server/runs/builtin.py): starts them once every student
 node has declared its subscriptions, ticks them at their rates, hands them the messages they
-subscribe to, and routes what they publish through the bus, the recording and - for command
-topics like teleop's Twist - to the robot.
+subscribe to, and gives what they publish to the run's one routing path (`RunCore.route`: bus,
+recording, the robot for command topics like teleop's Twist, other built-ins), as trusted.
 
 Built-ins speak ROS 1 message objects (sandbox.msgs) unless they say `ros2_native = True`. In a
 ROS 2 run the host converts at the robot's edge (server/runs/dialect.py) for the ROS 1 ones: what
@@ -9,6 +9,7 @@ they publish reaches the bus as ROS 2 CDR, what they receive arrives as ROS 1 ob
 native built-in (the NavigateToPose server) publishes and receives sandbox.msgs2 objects as they
 are, and is left out of a ROS 1 run. `graph_subscriptions()` puts a built-in in the run's graph as
 a subscriber, which a service or action server needs: a client's wait_for_service looks there.
+Every hook gets the run's core (server/runs/core.py) as `run`.
 """
 
 from __future__ import annotations
@@ -16,13 +17,13 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from sandbox.protocol import Envelope
+from sandbox.units import NS_PER_S
 from server.runs.builtin import BUILTIN_NODES, BuiltinNode
 from server.runs.nav2_server import NavigationServer
 
 if TYPE_CHECKING:
-    from server.runs.run import Run
+    from server.runs.core import RunCore
 
-NS = 1_000_000_000
 # The navigation server joins the built-ins here, not in builtin.py: it builds on the planner
 # there and on the ROS 2 action wire, so builtin.py cannot import it.
 BUILTIN_NODES.setdefault(NavigationServer.name, NavigationServer)
@@ -43,7 +44,7 @@ class BuiltinHost:
     def get(self, name: str) -> BuiltinNode | None:
         return next((node for node in self.nodes if node.name == name), None)
 
-    def published_topics(self, run: Run) -> list[tuple[str, str, float | None]]:
+    def published_topics(self, run: RunCore) -> list[tuple[str, str, float | None]]:
         """(topic, ROS type in the run's dialect, rate) of everything the built-ins publish,
         for the students."""
         return [
@@ -52,7 +53,7 @@ class BuiltinHost:
             for topic, kind in node.publishes
         ]
 
-    def start(self, run: Run) -> None:
+    def start(self, run: RunCore) -> None:
         for node in self.nodes:
             run.bus.add_node(node.name)
             for topic, kind in node.graph_subscriptions():
@@ -67,12 +68,12 @@ class BuiltinHost:
         started = [(node, node.start(run)) for node in self.nodes]
         for node in self.nodes:  # after start(): a node may take its rate from the run's params
             # start() publishes the time-0 message; ticks follow one period later.
-            self._next_ns[node.name] = round(NS / node.rate_hz) if node.rate_hz else 0
+            self._next_ns[node.name] = round(NS_PER_S / node.rate_hz) if node.rate_hz else 0
         for node, published in started:
             self.publish(run, node, published)
 
-    def publish(self, run: Run, node: BuiltinNode, published: list[tuple[str, object]]) -> None:
-        dialect = run.dialect
+    def publish(self, run: RunCore, node: BuiltinNode, published: list[tuple[str, object]]) -> None:
+        """Convert what `node` published to the run's dialect and route it (trusted)."""
         for topic, message in published:
             if node.ros2_native:
                 envelope = Envelope(topic, message._type, message.serialize())
@@ -82,18 +83,15 @@ class BuiltinHost:
                     "that speaks ROS 2 says ros2_native = True (server/runs/builtin.py)"
                 )
             else:
-                envelope = dialect.envelope(topic, message)
-            run.bus.publish(node.name, envelope, run.time_s)
-            run.record(topic, envelope.type, run.time_ns, envelope.data)
-            command = run.sim.robot.commands.get(topic)
-            if command is not None and not run.faults.motors_stalled():
-                # A native built-in's TwistStamped reaches a Twist topic as its twist.
-                ros1 = dialect.to_ros1(message, command[0]._type) if node.ros2_native else message
-                run.sim.apply(topic, ros1)  # trusted: a rejection is our bug, let it raise
-            self.deliver(run, node.name, topic, message, node.ros2_native)
+                envelope = run.dialect.envelope(topic, message)
+            run.route(node.name, envelope, message, node.ros2_native)
+
+    def listens_to(self, topic: str) -> bool:
+        """Does any built-in take messages on `topic`?"""
+        return any(node.listens_to(topic) for node in self.nodes)
 
     def deliver(
-        self, run: Run, source: str, topic: str, message: object, native: bool = False
+        self, run: RunCore, source: str, topic: str, message: object, native: bool = False
     ) -> None:
         """Hand `message` (a ROS 2 object if `native`, else ROS 1) to every built-in that
         listens to `topic`, converted to the dialect each speaks."""
@@ -108,16 +106,10 @@ class BuiltinHost:
                 mine = run.dialect.to_ros1(message)
             self.publish(run, node, node.on_message(run, topic, mine))
 
-    def deliver_envelope(self, run: Run, source: str, envelope: Envelope) -> None:
-        """A student node's message, decoded only if a built-in listens to its topic."""
-        if any(node.listens_to(envelope.topic) for node in self.nodes):
-            message = run.dialect.decode(envelope)
-            self.deliver(run, source, envelope.topic, message, run.dialect.ros2)
-
-    def tick(self, run: Run) -> None:
+    def tick(self, run: RunCore) -> None:
         for node in self.nodes:
             if node.rate_hz and self._next_ns[node.name] <= run.time_ns:
-                self._next_ns[node.name] = run.time_ns + round(NS / node.rate_hz)
+                self._next_ns[node.name] = run.time_ns + round(NS_PER_S / node.rate_hz)
                 self.publish(run, node, node.tick(run))
 
     def next_ns(self) -> int | None:

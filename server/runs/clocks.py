@@ -5,13 +5,16 @@ a wake time it chose (or, spinning, until a message arrives for it); the simulat
 from one wake-up to the next, never further than the next sensor message a spinning node may
 be waiting for. Nodes due at the same instant wake one after another in launch-file order, and
 what one publishes reaches the others at their next wake. Same seed, same code: the same
-recording, byte for byte.
+recorded messages, byte for byte.
 
 *Realtime* (wall clock, real-time factor 1): the simulation keeps advancing while nodes compute,
 so a slow controller shows up as latency, as on a real robot. Nodes are woken without waiting
 (`begin_wake`) and their replies collected as they come, so one slow node does not hold up the
 others; a command takes effect at the moment its reply arrives. Every realtime run of the
 process is driven by one scheduler thread (earliest deadline first), not a thread each.
+
+Both see a run only through `ClockedRun` (what is due, when the next event is, advance to) and
+share its one test of "is this node due" and "what happens next" (server/runs/core.py).
 """
 
 from __future__ import annotations
@@ -22,83 +25,98 @@ import select
 import sys
 import threading
 import time
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Protocol
 
-from server.runs.state import RunState
+from sandbox.units import NS_PER_S
 
 if TYPE_CHECKING:
-    from server.runs.run import Run
+    from server.runs.slots import NodeSlot
 
-NS = 1_000_000_000
 # Two spinning nodes can answer each other forever without time passing; after this many
 # wake rounds at one instant, time moves on to the next event.
 MAX_ROUNDS_PER_INSTANT = 100
-# [s] longest the realtime loop sleeps when nothing is due; controls and node replies wake it
+# [s] longest the realtime loop sleeps when nothing is due; commands and node replies wake it
 # earlier through their fds, so this only bounds how stale `progress` can look.
 REALTIME_IDLE_S = 0.05
 GIL_SWITCH_INTERVAL_S = 0.0005  # [s] see run_realtime
 REALTIME_REPLY_ROUNDS = 4  # rounds of collecting replies and waking nodes in one realtime step
+PAUSED_POLL_S = 0.1  # [s] a paused lockstep loop waits this long for a command at a time
 
 
-def run_lockstep(run: Run) -> None:
+class ClockedRun(Protocol):
+    """What a clock sees of a run (server/runs/core.py's RunCore): when things are due, and
+    the means to move time on and wake nodes. A clock never reaches further into the run."""
+
+    time_ns: int  # run time reached [ns]
+    duration_ns: int  # [ns] the run covers [0, duration)
+
+    @property
+    def tick_s(self) -> float: ...  # [s] the robot's smallest step
+
+    @property
+    def paused(self) -> bool: ...
+
+    @property
+    def command_fd(self) -> int: ...  # readable while a command waits
+
+    def apply_commands(self) -> None: ...
+
+    def wait_for_command(self, timeout_s: float) -> None: ...
+
+    def due_nodes(self, now_ns: int) -> list[NodeSlot]: ...
+
+    def next_event_ns(self, *, every_publication: bool) -> int: ...
+
+    def advance_to(self, time_ns: int) -> None: ...
+
+    def wake(self, slot: NodeSlot, now_ns: int) -> None: ...  # and wait for its reply
+
+    def begin_wake(self, slot: NodeSlot, now_ns: int) -> None: ...  # without waiting
+
+    def collect_replies(self) -> bool: ...
+
+    def reply_fds(self) -> list[int]: ...
+
+
+def run_lockstep(run: ClockedRun) -> None:
     rounds = 0
-    order = list(run.slots.values())
+    tick_ns = round(run.tick_s * NS_PER_S)
     while True:
-        run._apply_controls()
-        while run.state is RunState.PAUSED:
-            run.wait_while_paused(0.1)
+        run.apply_commands()
+        while run.paused:
+            run.wait_for_command(PAUSED_POLL_S)
         now = run.time_ns
         if now >= run.duration_ns:
             return  # the run covers [0, duration): nothing wakes at its last instant
-        due = [slot for slot in order if not slot.done and run.is_due(slot, now)]
+        due = run.due_nodes(now)
         if due and rounds < MAX_ROUNDS_PER_INSTANT:
             rounds += 1
             for slot in due:
-                if not slot.done:
-                    run.wake(slot, now)
+                run.wake(slot, now)
             continue
         rounds = 0
-        run.advance_to(_next_event_ns(run))
-
-
-def _next_event_ns(run: Run) -> int:
-    candidates = [run.duration_ns]
-    for upcoming in (run.next_script_ns(), run.next_builtin_ns(), run.next_tf_ns()):
-        if upcoming is not None:
-            candidates.append(upcoming)
-    spinning = False
-    for slot in run.slots.values():
-        if slot.done:
-            continue
-        if run.listens(slot):
-            spinning = True
-        if slot.wake_at_ns is not None:
-            candidates.append(slot.wake_at_ns)
-    if spinning:
-        # A spinning node wakes on messages: stop where the robot next publishes.
-        candidates.append(round(run.sim.next_publication_s() * NS))
-    next_ns = min(candidates)
-    tick_ns = round(run.sim._tick_s * NS)
-    return max(next_ns, run.time_ns + tick_ns)  # always move on by at least one tick
+        # The robot's publications are events only while a node may wake on one: a longer
+        # step publishes the same messages. Always move on by at least one tick.
+        next_ns = run.next_event_ns(every_publication=False)
+        run.advance_to(max(next_ns, now + tick_ns))
 
 
 class RealtimeDriver:
     """One realtime run, advanced in non-blocking steps by the shared scheduler."""
 
-    def __init__(self, run: Run) -> None:
+    def __init__(self, run: ClockedRun) -> None:
         self.run = run
         self.start = time.monotonic()
-        self.order = list(run.slots.values())
         self.deadline = self.start  # monotonic time of the next thing to do
-        self.fds: list[int] = [run.control_signal_fd]
+        self.fds: list[int] = [run.command_fd]
         self.finished = threading.Event()
         self.error: BaseException | None = None
 
     def step(self) -> bool:
         """Do what is due now; False once the run's duration is reached."""
-        run, order = self.run, self.order
-        run._apply_controls()
-        now_ns = round((time.monotonic() - self.start) * NS)
+        run = self.run
+        run.apply_commands()
+        now_ns = round((time.monotonic() - self.start) * NS_PER_S)
         run.advance_to(min(now_ns, run.duration_ns))
         if run.time_ns >= run.duration_ns:
             return False
@@ -107,42 +125,15 @@ class RealtimeDriver:
         # deadline (a few rounds at most: a busy node replies at once, every time).
         replied, rounds = True, 0
         while replied and rounds < REALTIME_REPLY_ROUNDS:
-            replied, rounds = False, rounds + 1
-            for slot in order:
-                if slot.done or slot.process is None:
-                    continue
-                if slot.process.state == "running":
-                    reply = slot.process.poll_reply(0.0)
-                    if reply is not None:
-                        run.handle_reply(slot, reply)
-                        replied = True
-                if slot.done:
-                    continue
-                if slot.process.state == "sleeping" and run.is_due(slot, run.time_ns):
-                    run.begin_wake(slot, run.time_ns)
+            rounds += 1
+            replied = run.collect_replies()
+            for slot in run.due_nodes(run.time_ns):
+                run.begin_wake(slot, run.time_ns)
         # Next: a sleeping node's wake time, the robot's next message, or an idle check; a
         # node still computing is not due (its reply makes its fds readable).
-        running = [
-            s
-            for s in order
-            if not s.done and s.process is not None and s.process.state == "running"
-        ]
-        upcoming = [
-            t
-            for t in (run.next_script_ns(), run.next_builtin_ns(), run.next_tf_ns())
-            if t is not None
-        ]
-        next_ns = min(
-            [run.duration_ns, round(run.sim.next_publication_s() * NS)]
-            + upcoming
-            + [
-                s.wake_at_ns
-                for s in order
-                if not s.done and s.wake_at_ns is not None and s not in running
-            ]
-        )
-        self.deadline = min(self.start + next_ns / NS, time.monotonic() + REALTIME_IDLE_S)
-        self.fds = [run.control_signal_fd] + [fd for s in running for fd in s.process.reply_fds]
+        next_ns = run.next_event_ns(every_publication=True)
+        self.deadline = min(self.start + next_ns / NS_PER_S, time.monotonic() + REALTIME_IDLE_S)
+        self.fds = [run.command_fd, *run.reply_fds()]
         return True
 
 
@@ -213,7 +204,7 @@ _scheduler: RealtimeScheduler | None = None
 _scheduler_lock = threading.Lock()
 
 
-def run_realtime(run: Run) -> None:
+def run_realtime(run: ClockedRun) -> None:
     """Drive `run` on the shared realtime scheduler; return (or raise its end) when done."""
     global _scheduler
     # Other threads (recorders writing chunks) hold the GIL for up to the switch interval,

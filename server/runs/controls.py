@@ -1,22 +1,20 @@
-"""Commands while a run runs (server/runs/commands.py): stop, pause/resume (lockstep), the
-robot's button, a light, a goal pose, a key, a fault. Any thread may send them (the web
-server's, the CLI's signal handler); they are queued and applied by the run's own loop between
-two steps, so the simulation never sees two threads. A byte on a pipe wakes a realtime loop
-that is sleeping until its next event.
+"""What the typed commands (server/runs/commands.py) do to a run: stop, pause/resume (lockstep),
+the robot's button, a light, a goal pose, a key, a fault.
+
+`refuse` runs on the sender's thread, when the command is given, and says why the run's state
+refuses it now; `apply` runs on the run's own loop, between two steps, when the command is taken
+from the run's inbox (server/runs/inbox.py), so the robot never sees two threads.
 """
 
 from __future__ import annotations
 
-import contextlib
 import logging
-import os
-import queue
 from typing import TYPE_CHECKING
 
 from sandbox.protocol import Clock
+from sandbox.units import NS_PER_S
 from server.runs.commands import (
     Button,
-    CommandError,
     EmergencyStop,
     Goal,
     InjectFault,
@@ -33,110 +31,53 @@ from server.runs.state import RunState
 from server.sim.simulation import SimulationError
 
 if TYPE_CHECKING:
-    from server.runs.run import Run
+    from server.runs.core import RunCore
 
 log = logging.getLogger("robodojo.runs")
-NS = 1_000_000_000
 
 
-class RunControls:
-    """Mixed into Run: the public control methods and how the loop applies them."""
+def refuse(core: RunCore, command: RunCommand) -> str | None:
+    """Why `command` cannot be taken now, as a sentence; None when it can."""
+    match command:
+        case Pause() if core.spec.clock is not Clock.LOCKSTEP:
+            return "only a lockstep (simulated-time) run can pause; stop it instead"
+        case Pause() if core.state is RunState.PAUSED:
+            return "the run is already paused; resume it to go on"
+        case Resume() if core.state is not RunState.PAUSED:
+            return f"the run is not paused (it is {core.state}); nothing to resume"
+        case Teleop() if core.builtins.get("teleop") is None:
+            return "this run takes no keyboard driving (its exercise has no teleop)"
+    return None
 
-    def __init__(self: Run) -> None:
-        self._controls: queue.SimpleQueue = queue.SimpleQueue()
-        self._control_signal_r, self._control_signal_w = os.pipe()
-        os.set_blocking(self._control_signal_r, False)
-        os.set_blocking(self._control_signal_w, False)
 
-    def _close_controls(self: Run) -> None:
-        for fd in (self._control_signal_r, self._control_signal_w):
-            with contextlib.suppress(OSError):
-                os.close(fd)
-
-    def command(self, command: RunCommand) -> None:
-        """Take a command (server/runs/commands.py) from any thread; it is applied by the run's
-        loop between two steps. Raises CommandError when the run's state refuses it now."""
-        if isinstance(command, Pause):
-            if self.spec.clock is not Clock.LOCKSTEP:
-                raise CommandError(
-                    "only a lockstep (simulated-time) run can pause; stop it instead"
-                )
-            if self.state is RunState.PAUSED:
-                raise CommandError("the run is already paused; resume it to go on")
-        elif isinstance(command, Resume) and self.state is not RunState.PAUSED:
-            raise CommandError(f"the run is not paused (it is {self.state}); nothing to resume")
-        elif isinstance(command, Teleop) and self.builtins.get("teleop") is None:
-            raise CommandError("this run takes no keyboard driving (its exercise has no teleop)")
-        elif isinstance(command, EmergencyStop) and self.backend is not None:
-            self.backend.stop()  # a real robot stops now, from this thread, not at the next step
-        self._control(command)
-
-    def stop(self, reason: str = "stopped by the user") -> None:
-        self.command(Stop(reason))
-
-    def _control(self, command: RunCommand) -> None:
-        self._controls.put(command)
-        # Wake a realtime loop that sleeps until its next event (see clocks.run_realtime).
-        with contextlib.suppress(BlockingIOError, OSError):
-            os.write(self._control_signal_w, b"!")
-
-    @property
-    def control_signal_fd(self) -> int:
-        """Readable when a control is waiting: a sleeping loop can poll it."""
-        return self._control_signal_r
-
-    @property
-    def progress(self) -> tuple[float, float]:
-        """(run time [s], duration [s])."""
-        return self.time_ns / NS, self.spec.duration_s
-
-    def _apply_controls(self) -> None:
-        if self._controls.empty():  # the common case, checked without a system call
-            return
-        with contextlib.suppress(BlockingIOError, OSError):
-            os.read(self._control_signal_r, 4096)
-        while True:
+def apply(core: RunCore, command: RunCommand) -> None:
+    """Do what `command` says, on the run's loop. Stop raises RunEnd (the loop ends the run)."""
+    match command:
+        case Stop() | EmergencyStop():
+            raise RunEnd(RunState.INTERRUPTED, f"interrupted: {command.reason}")
+        case Pause() if core.state is RunState.RUNNING:
+            core.move(RunState.PAUSED)
+        case Resume() if core.state is RunState.PAUSED:
+            core.move(RunState.RUNNING)
+        case Button(pressed=pressed):
+            core.sim.press_button(pressed)
+        case Light(x=x, y=y, name=name):
+            movable = [light.name for light in core.sim.lights if light.movable]
             try:
-                command = self._controls.get_nowait()
-            except queue.Empty:
-                return
-            self._apply_command(command)
-
-    def _apply_command(self, command: RunCommand) -> None:
-        match command:
-            case Stop() | EmergencyStop():
-                raise RunEnd(RunState.INTERRUPTED, f"interrupted: {command.reason}")
-            case Pause() if self.state is RunState.RUNNING:
-                self._move(RunState.PAUSED)
-            case Resume() if self.state is RunState.PAUSED:
-                self._move(RunState.RUNNING)
-            case Button(pressed=pressed):
-                self.sim.press_button(pressed)
-            case Light(x=x, y=y, name=name):
-                movable = [light.name for light in self.sim.lights if light.movable]
-                try:
-                    if name is None and not movable:
-                        raise SimulationError("this world has no light that can be moved")
-                    self.sim.move_light(name if name is not None else movable[0], x, y)
-                except SimulationError as error:
-                    log.info("run %s: light not moved: %s", self.run_id, error)
-            case Goal(x=x, y=y, yaw=yaw):
-                self._publish_goal(x, y, yaw)
-            case Teleop(key=key, pressed=pressed):
-                teleop = self.builtins.get("teleop")
-                if teleop is None:
-                    log.info("run %s: a teleop key, but the run has no teleop node", self.run_id)
-                else:
-                    teleop.key(key, pressed)
-            case InjectFault(kind=kind, topic=topic, duration_s=duration_s):
-                self.faults.add(Fault(kind, topic, self.time_ns + round(duration_s * NS)))
-                if kind is FaultKind.STALL_MOTORS:
-                    self._stall_motors()
-
-    def wait_while_paused(self, timeout_s: float) -> None:
-        """Block up to `timeout_s` for a control while paused (the loop calls this)."""
-        try:
-            command = self._controls.get(timeout=timeout_s)
-        except queue.Empty:
-            return
-        self._apply_command(command)
+                if name is None and not movable:
+                    raise SimulationError("this world has no light that can be moved")
+                core.sim.move_light(name if name is not None else movable[0], x, y)
+            except SimulationError as error:
+                log.info("run %s: light not moved: %s", core.run_id, error)
+        case Goal(x=x, y=y, yaw=yaw):
+            core.edge.publish_goal(x, y, yaw, core.time_ns)
+        case Teleop(key=key, pressed=pressed):
+            teleop = core.builtins.get("teleop")
+            if teleop is None:
+                log.info("run %s: a teleop key, but the run has no teleop node", core.run_id)
+            else:
+                teleop.key(key, pressed)
+        case InjectFault(kind=kind, topic=topic, duration_s=duration_s):
+            core.faults.add(Fault(kind, topic, core.time_ns + round(duration_s * NS_PER_S)))
+            if kind is FaultKind.STALL_MOTORS:
+                core.edge.stall_motors()

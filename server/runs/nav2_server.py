@@ -52,7 +52,7 @@ from server.runs.nav2_wire import (
 from server.sim.geometry import yaw_quaternion
 
 if TYPE_CHECKING:
-    from server.runs.run import Run
+    from server.runs.core import RunCore as Run  # built-ins are handed the run's core
 
 CONTROLLER_FREQUENCY_HZ = 20.0  # [Hz] Nav2's controller_server default
 SERVICE_PATIENCE_S = 1.0  # [s] a goal waits this long for an unserved controller service
@@ -154,7 +154,7 @@ class NavigationServer(BuiltinNode):
         return []
 
     def log(self, run: Run, level: str, text: str) -> None:
-        run._emit_logs(self.name, [format_log_line(level, run.time_s, text)])
+        run.outputs.log(self.name, [format_log_line(level, run.time_s, text)])
 
     # ------------------------------------------------------------------ requests
     def on_message(self, run: Run, topic: str, message: object) -> list[tuple[str, object]]:

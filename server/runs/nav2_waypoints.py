@@ -18,8 +18,8 @@ from sandbox.units import NS_PER_S
 from server.runs.nav2_wire import with_error
 
 if TYPE_CHECKING:
+    from server.runs.core import RunCore as Run  # built-ins are handed the run's core
     from server.runs.nav2_server import NavigationServer
-    from server.runs.run import Run
 
 WAYPOINT_PAUSE_S = 0.2  # [s] WaitAtWaypoint's waypoint_pause_duration default (200 ms)
 

@@ -1,6 +1,7 @@
-"""What leaves a run while it runs: every message into the recording and to a live observer,
-the nodes' log lines (and a real robot's own) into the log files and to the observer.
-Mixed into Run; split from run.py so the loop and the plumbing each stay one concept.
+"""What leaves a run while it runs, through sinks the run is given: every message (into the
+recording, to a live observer), the nodes' log lines (and a real robot's own) and the run's
+state changes. The engine calls `RunOutputs`; which sinks listen is decided by whoever builds
+the run (server/runs/run.py), so the engine never asks whether anyone watches.
 
 An observer (the web service's telemetry) is called on the run's own thread; its failures are
 logged and never end the run.
@@ -9,15 +10,22 @@ logged and never end the run.
 from __future__ import annotations
 
 import logging
-from typing import TYPE_CHECKING, Protocol
+from typing import Protocol
 
+from server.runs.recorder import Recorder
 from server.runs.state import RunState
 
-if TYPE_CHECKING:
-    from server.runs.run import NodeSlot, Run
-
 log = logging.getLogger("robodojo.runs")
-NS = 1_000_000_000
+
+
+class RunSink(Protocol):
+    """One listener to what a run puts out. Called on the run's own thread."""
+
+    def record(self, topic: str, type_name: str, time_ns: int, data: bytes) -> None: ...
+
+    def log(self, node: str, lines: list[str]) -> None: ...
+
+    def state(self, state: RunState, reason: str, time_s: float) -> None: ...
 
 
 class RunObserver(Protocol):
@@ -32,45 +40,81 @@ class RunObserver(Protocol):
     def on_state(self, state: RunState, reason: str, time_s: float) -> None: ...
 
 
-class RunOutputs:
-    """Mixed into Run: the recording and the observer, fed from one place each."""
+class RecordingSink:
+    """Messages into the run's MCAP file, log lines into its log files (server/runs/recorder.py
+    keeps both off the run's thread)."""
 
-    def record(self: Run, topic: str, type_name: str, time_ns: int, data: bytes) -> None:
-        """One message into the recording and, if someone watches, to the observer."""
+    def __init__(self, recorder: Recorder) -> None:
+        self.recorder = recorder
+
+    def record(self, topic: str, type_name: str, time_ns: int, data: bytes) -> None:
         self.recorder.record(topic, type_name, time_ns, data)
-        if self.observer is not None:
-            try:
-                self.observer.on_message(topic, type_name, time_ns, data)
-            except Exception:
-                log.exception("run %s: the observer failed on a message", self.run_id)
-                self.observer = None  # one report, not one per message
 
-    def _collect_logs(self: Run, slot: NodeSlot) -> None:
-        if slot.process is None:
+    def log(self, node: str, lines: list[str]) -> None:
+        self.recorder.write_log(node, lines)
+
+    def state(self, state: RunState, reason: str, time_s: float) -> None:
+        pass  # the recording holds the result (metrics.json), not the transitions
+
+
+class ObserverSink:
+    """A `RunObserver` behind a guard: whatever it raises is logged, and an observer that fails
+    on a message is dropped (one report, not one per message)."""
+
+    def __init__(self, observer: RunObserver, run_id: str) -> None:
+        self.observer: RunObserver | None = observer
+        self.run_id = run_id
+
+    def record(self, topic: str, type_name: str, time_ns: int, data: bytes) -> None:
+        if self.observer is None:
             return
-        lines = slot.process.logs.take()
+        try:
+            self.observer.on_message(topic, type_name, time_ns, data)
+        except Exception:
+            log.exception("run %s: the observer failed on a message", self.run_id)
+            self.observer = None
+
+    def log(self, node: str, lines: list[str]) -> None:
+        if self.observer is None:
+            return
+        try:
+            self.observer.on_logs(node, list(lines))
+        except Exception:
+            log.exception("run %s: the observer failed on log lines", self.run_id)
+
+    def state(self, state: RunState, reason: str, time_s: float) -> None:
+        if self.observer is None:
+            return
+        try:
+            self.observer.on_state(state, reason, time_s)
+        except Exception:  # a viewer's problem never ends a run
+            log.exception("run %s: the observer failed on a state change", self.run_id)
+
+
+class RunOutputs:
+    """The sinks of one run, fed in order (the recording is put first, so a viewer never sees
+    a message before the file has it)."""
+
+    def __init__(self, *sinks: RunSink) -> None:
+        self.sinks: tuple[RunSink, ...] = sinks
+
+    def add(self, sink: RunSink, first: bool = False) -> None:
+        self.sinks = (sink, *self.sinks) if first else (*self.sinks, sink)
+
+    def remove(self, sink: RunSink) -> None:
+        self.sinks = tuple(s for s in self.sinks if s is not sink)
+
+    def record(self, topic: str, type_name: str, time_ns: int, data: bytes) -> None:
+        """One message (serialized in the run's dialect) at run time `time_ns` [ns]."""
+        for sink in self.sinks:
+            sink.record(topic, type_name, time_ns, data)
+
+    def log(self, node: str, lines: list[str]) -> None:
+        """Lines of a node (or of the robot itself, node "robot")."""
         if lines:
-            self._log_lines(slot, lines)
+            for sink in self.sinks:
+                sink.log(node, lines)
 
-    def _log_lines(self: Run, slot: NodeSlot, lines: list[str]) -> None:
-        slot.logs.extend(lines)
-        self._emit_logs(slot.name, lines)
-
-    def _emit_logs(self: Run, node: str, lines: list[str]) -> None:
-        """Lines of a node (or of the robot itself) into its log file and to the observer."""
-        if not lines:
-            return
-        if self.recorder is not None:
-            self.recorder.write_log(node, lines)
-        if self.observer is not None:
-            try:
-                self.observer.on_logs(node, list(lines))
-            except Exception:
-                log.exception("run %s: the observer failed on log lines", self.run_id)
-
-    def _tell_state(self: Run, state: RunState) -> None:
-        if self.observer is not None:
-            try:
-                self.observer.on_state(state, self.reason, self.time_ns / NS)
-            except Exception:  # a viewer's problem never ends a run
-                log.exception("run %s: the observer failed on a state change", self.run_id)
+    def state(self, state: RunState, reason: str, time_s: float) -> None:
+        for sink in self.sinks:
+            sink.state(state, reason, time_s)

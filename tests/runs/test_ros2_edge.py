@@ -49,7 +49,7 @@ def prepared(tmp_path, robot="crowbot", world="wall_approach", **kw) -> Run:
         **kw,
     )
     run = Run(spec, launcher=None, out_dir=tmp_path)
-    run._prepare()
+    run.core.prepare()
     run.bus.add_node("driver")
     return run
 
@@ -81,7 +81,7 @@ def test_the_robot_is_declared_and_described_in_ros2_names(tmp_path):
     assert types["Control"] == "geometry_msgs/msg/Twist"
     assert types["goal"] == "geometry_msgs/msg/PoseStamped"
     assert types["tf"] == "tf2_msgs/msg/TFMessage"
-    info = run._node_info(run.spec.nodes[0])
+    info = run.core.node_info(run.spec.nodes[0])
     assert info.ros_version == 2
     assert {t.name: t.type for t in info.robot_topics}["Light"] == "std_msgs/msg/Int32MultiArray"
     assert {t.name: t.type for t in info.robot_topics}["goal"] == "geometry_msgs/msg/PoseStamped"
@@ -92,7 +92,7 @@ def test_sensor_messages_and_tf_reach_nodes_as_ros2_cdr(tmp_path):
     run = prepared(tmp_path)
     listen(run, "Distance", "std_msgs/msg/Int32")
     run.bus.declare("listener", [], [TopicDecl("tf", "tf2_msgs/msg/TFMessage")])
-    run.advance_to(NS // 2)
+    run.core.advance_to(NS // 2)
     messages = received(run)
     distances = [m for topic, _, m in messages if topic == "Distance"]
     assert distances, "the ultrasonic sensor published nothing in half a second"
@@ -109,10 +109,10 @@ def test_sensor_messages_and_tf_reach_nodes_as_ros2_cdr(tmp_path):
 def test_twist_and_twist_stamped_both_drive_the_robot(tmp_path):
     run = prepared(tmp_path)
     slot = run.slots["driver"]
-    run._from_node(slot, [twist(0.2, 0.5)])
+    run.core.from_node(slot, [twist(0.2, 0.5)])
     assert run.sim.read("Control")._type == "geometry_msgs/Twist"  # the simulator's ROS 1 class
     assert (run.sim.read("Control").linear.x, run.sim.read("Control").angular.z) == (0.2, 0.5)
-    run._from_node(slot, [twist(-0.1, 0.0, stamped=True, sec=3)])
+    run.core.from_node(slot, [twist(-0.1, 0.0, stamped=True, sec=3)])
     assert run.sim.read("Control").linear.x == pytest.approx(-0.1)
     assert slot.metrics.rejected_commands == 0
     run.recorder.close()
@@ -121,7 +121,7 @@ def test_twist_and_twist_stamped_both_drive_the_robot(tmp_path):
 def test_other_command_topics_take_their_ros2_type(tmp_path):
     run = prepared(tmp_path)
     leds = get_message_class("std_msgs/msg/Int32MultiArray")(data=[255, 0, 64])
-    run._from_node(run.slots["driver"], [Envelope("Leds", leds._type, leds.serialize())])
+    run.core.from_node(run.slots["driver"], [Envelope("Leds", leds._type, leds.serialize())])
     assert run.sim.read("Leds")._type == "std_msgs/Int32MultiArray"
     assert list(run.sim.read("Leds").data) == [255, 0, 64]
     run.recorder.close()
@@ -130,10 +130,10 @@ def test_other_command_topics_take_their_ros2_type(tmp_path):
 def test_another_type_on_the_velocity_topic_is_said_once_and_ignored(tmp_path):
     run = prepared(tmp_path)
     slot = run.slots["driver"]
-    run._from_node(slot, [twist(0.2, 0.0)])
+    run.core.from_node(slot, [twist(0.2, 0.0)])
     wrong = get_message_class("std_msgs/msg/Float32")(data=1.0)
     envelope = Envelope("Control", "std_msgs/msg/Float32", wrong.serialize())
-    run._from_node(slot, [envelope, envelope, envelope])
+    run.core.from_node(slot, [envelope, envelope, envelope])
     said = [line for line in slot.logs if "Control" in line]
     assert said == [
         "[robot] 'Control' takes geometry_msgs/msg/Twist or geometry_msgs/msg/TwistStamped, not "
@@ -148,7 +148,7 @@ def test_a_subscriber_gets_only_the_type_it_subscribed_with_on_the_velocity_topi
     run = prepared(tmp_path)
     listen(run, "Control", "geometry_msgs/msg/TwistStamped")
     slot = run.slots["driver"]
-    run._from_node(slot, [twist(0.1, 0.0), twist(0.3, 0.0, stamped=True)])
+    run.core.from_node(slot, [twist(0.1, 0.0), twist(0.3, 0.0, stamped=True)])
     assert [(topic, kind) for topic, kind, _ in received(run)] == [
         ("Control", "geometry_msgs/msg/TwistStamped")
     ]
@@ -157,9 +157,9 @@ def test_a_subscriber_gets_only_the_type_it_subscribed_with_on_the_velocity_topi
 
 def test_the_zero_command_at_the_end_uses_the_type_the_node_used(tmp_path):
     run = prepared(tmp_path)
-    run._from_node(run.slots["driver"], [twist(0.3, 0.0, stamped=True)])
-    run.advance_to(NS)
-    run._command_zero()
+    run.core.from_node(run.slots["driver"], [twist(0.3, 0.0, stamped=True)])
+    run.core.advance_to(NS)
+    run.core.edge.command_zero(run.time_ns)
     assert run.sim.read("Control").linear.x == 0.0
     paths = run.recorder.close()
 
@@ -173,7 +173,7 @@ def test_the_goal_is_a_ros2_pose_stamped(tmp_path):
     run = prepared(tmp_path)
     listen(run, "goal", "geometry_msgs/msg/PoseStamped")
     run.command(Goal(1.0, -0.5, math.pi / 2))
-    run._apply_controls()
+    run.core.apply_commands()
     [(_, kind, goal)] = received(run)
     assert kind == "geometry_msgs/msg/PoseStamped"
     assert (goal.pose.position.x, goal.pose.position.y) == (1.0, -0.5)
@@ -186,10 +186,10 @@ def test_faults_act_on_the_converted_messages(tmp_path):
     run = prepared(tmp_path)
     listen(run, "Distance", "std_msgs/msg/Int32")
     run.command(InjectFault(FaultKind.DROP_TOPIC, "Distance", 1.0))
-    run._apply_controls()
-    run.advance_to(NS // 2)
+    run.core.apply_commands()
+    run.core.advance_to(NS // 2)
     assert received(run) == []
-    run.advance_to(2 * NS)  # the fault cleared at 1 s
+    run.core.advance_to(2 * NS)  # the fault cleared at 1 s
     assert [kind for _, kind, _ in received(run)][-1] == "std_msgs/msg/Int32"
     run.recorder.close()
 
@@ -203,15 +203,15 @@ def test_ros1_builtins_publish_ros2_and_take_a_nodes_ros2_goal(tmp_path):
     )
     listen(run, "pose", "geometry_msgs/msg/PoseStamped")
     run.bus.declare("listener", [], [TopicDecl("plan", "nav_msgs/msg/Path")])
-    run.builtins.start(run)
-    info = run._node_info(run.spec.nodes[0])
+    run.builtins.start(run.core)
+    info = run.core.node_info(run.spec.nodes[0])
     assert {t.name: t.type for t in info.robot_topics}["map"] == "nav_msgs/msg/OccupancyGrid"
     assert run.bus.topics["map"].type == "nav_msgs/msg/OccupancyGrid"
     goal = get_message_class("geometry_msgs/msg/PoseStamped")()
     goal.header.frame_id = "map"
     goal.pose.position.x, goal.pose.position.y = run.sim.state.pose.x + 0.5, run.sim.state.pose.y
     envelope = Envelope("goal_pose", goal._type, goal.serialize())
-    run._from_node(run.slots["driver"], [envelope])
+    run.core.from_node(run.slots["driver"], [envelope])
     messages = received(run)
     pose = [m for topic, _, m in messages if topic == "pose"][-1]
     assert pose.pose.position.x == pytest.approx(run.sim.state.pose.x)
@@ -219,8 +219,8 @@ def test_ros1_builtins_publish_ros2_and_take_a_nodes_ros2_goal(tmp_path):
     assert plan._type == "nav_msgs/msg/Path" and len(plan.poses) >= 2
     # teleop's ROS 1 Twist drives the robot and is recorded as a ROS 2 Twist.
     run.command(Teleop("up", True))
-    run._apply_controls()
-    run.advance_to(NS)
+    run.core.apply_commands()
+    run.core.advance_to(NS)
     assert run.sim.read("cmd_vel").linear.x > 0
     paths = run.recorder.close()
 
@@ -254,12 +254,13 @@ class EchoService(BuiltinNode):
 def test_a_ros2_native_builtin_is_a_graph_subscriber_and_speaks_ros2(tmp_path, monkeypatch):
     monkeypatch.setitem(BUILTIN_NODES, "echo_service", EchoService)
     run = prepared(tmp_path, builtin_nodes=("echo_service",))
-    run.builtins.start(run)
+    run.builtins.start(run.core)
     topics = {t.name: t for t in run.bus.graph_topics()}
     assert topics["__srv__/echo"].subscribers == ["echo_service"]  # wait_for_service sees it
     listen(run, "echoed", "std_msgs/msg/String")
     call = get_message_class("std_msgs/msg/String")(data="hello")
-    run._from_node(run.slots["driver"], [Envelope("__srv__/echo", call._type, call.serialize())])
+    request = Envelope("__srv__/echo", call._type, call.serialize())
+    run.core.from_node(run.slots["driver"], [request])
     assert run.builtins.get("echo_service").seen == call  # the ROS 2 object, not a ROS 1 one
     assert [(t, m.data) for t, _, m in received(run)] == [("echoed", "hello!")]
     assert run.sim.read("Control").linear.x == pytest.approx(0.05)  # the twist of it
@@ -295,5 +296,5 @@ def test_a_builtin_publishing_ros2_without_saying_so_gets_a_sentence(tmp_path, m
     monkeypatch.setitem(BUILTIN_NODES, "forgetful", ForgetfulNative)
     run = prepared(tmp_path, builtin_nodes=("forgetful",))
     with pytest.raises(TypeError, match="says ros2_native = True"):
-        run.builtins.start(run)
+        run.builtins.start(run.core)
     run.recorder.close()

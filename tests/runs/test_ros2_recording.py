@@ -53,20 +53,20 @@ def recorded(tmp_path_factory) -> tuple[Run, dict[str, str]]:
         goal=(1.0, 0.0, 0.0),
     )
     run = Run(spec, launcher=None, out_dir=out)
-    run._prepare()
+    run.core.prepare()
     run.bus.add_node("driver")
-    run.builtins.start(run)
+    run.builtins.start(run.core)
     stamped = get_message_class("geometry_msgs/msg/TwistStamped")()
     stamped.twist.linear.x, stamped.twist.angular.z = 0.1, 0.2
     call = get_message_class("robodojo_msgs/msg/ServiceCall")(service="s", reply_to="r", id=1)
     for step in range(1, 31):
-        run.advance_to(step * NS // 10)
-        run._from_node(
+        run.core.advance_to(step * NS // 10)
+        run.core.from_node(
             run.slots["driver"],
             [Envelope("cmd_vel", stamped._type, stamped.serialize())]
             + ([Envelope("__srv__/s", call._type, call.serialize())] if step == 5 else []),
         )
-    run._command_zero()
+    run.core.edge.command_zero(run.time_ns)
     run.recorder.write_json("metrics", run.metrics())
     return run, run.recorder.close()
 

@@ -398,19 +398,24 @@ def test_the_papers_four_node_graph_runs_as_four_sandboxes(tmp_path, launcher):
     assert topics["motor_command"]["rate_hz"] == pytest.approx(50.0, rel=0.1)
 
 
-class FailingSimRun(Run):
-    """A robot backend that raises after a while (the fault a broken driver would cause)."""
+def failing_sim_run(spec: RunSpec, launcher, out_dir) -> Run:
+    """A run whose robot backend raises after a while (the fault a broken driver would cause)."""
+    run = Run(spec, launcher, out_dir)
+    prepare = run.core.prepare
 
-    def _prepare(self) -> None:
-        super()._prepare()
-        real_step = self.sim.step
+    def prepare_failing() -> None:
+        prepare()
+        real_step = run.sim.step
 
         def step(dt_s: float):
-            if self.sim.time_s > 1.0:
+            if run.sim.time_s > 1.0:
                 raise RuntimeError("motor controller stopped answering")
             return real_step(dt_s)
 
-        self.sim.step = step
+        run.sim.step = step
+
+    run.core.prepare = prepare_failing
+    return run
 
 
 def test_a_raising_robot_backend_or_recorder_ends_only_its_run(tmp_path, launcher):
@@ -419,7 +424,7 @@ def test_a_raising_robot_backend_or_recorder_ends_only_its_run(tmp_path, launche
     thread = threading.Thread(target=lambda: results.setdefault("good", good.execute()))
     thread.start()
     spec = RunSpec("crowbot", "wall_approach", (node(STEP_APPROACH),), duration_s=5.0)
-    broken = FailingSimRun(spec, launcher, tmp_path / "broken").execute()
+    broken = failing_sim_run(spec, launcher, tmp_path / "broken").execute()
     assert broken.state is RunState.FAILED
     assert "motor controller stopped answering" in broken.reason
     full_disk = tmp_path / "full"
