@@ -8,7 +8,6 @@ leaves the robot commanded to zero velocity through `command_zero`.
 from __future__ import annotations
 
 import logging
-import math
 
 from sandbox.msgs import Time
 from sandbox.msgs.geometry_msgs import Point, Pose, PoseStamped, Quaternion
@@ -26,6 +25,7 @@ from server.runs.slots import NodeSlot
 from server.runs.state import RunState
 from server.runs.tf import tf_message
 from server.sim.backend import RobotBackend
+from server.sim.geometry import yaw_quaternion
 from server.sim.robots.base import CommandError, Direction
 from server.sim.simulation import SimulationError
 
@@ -175,8 +175,7 @@ class RobotEdge:
             header=Header(stamp=Time.from_sec(now_ns / NS_PER_S), frame_id="map"),
             pose=Pose(
                 position=Point(x=x, y=y),
-                # TODO(sim): the yaw-to-quaternion helper of server/sim/geometry.py once it lands
-                orientation=Quaternion(z=math.sin(yaw / 2), w=math.cos(yaw / 2)),
+                orientation=Quaternion(*yaw_quaternion(yaw)),
             ),
         )
         self._publish(GOAL_TOPIC, goal, now_ns)
