@@ -8,12 +8,15 @@ It offers the part of `Simulation`'s interface a Run uses (topics, apply, step, 
 `step()` hands over what the robot sent since the last call, timed on the run's clock;
 `apply()` passes commands through the safety layer (server/hardware/safety.py) before the link.
 The watchdog runs in `step()`: a node that stops commanding for 500 ms stops the robot. When
-the link drops, `step()` raises `RobotLost` and the run ends "failed: robot disconnected".
+the link drops, `step()` raises `RobotLost` and the run ends "failed: robot disconnected"; when
+a sensor topic goes silent past its bound (server/hardware/silence.py), `step()` sends zero
+velocity and raises `RobotSilent`: "failed: robot stopped sending Distance for 0.3 s".
 Every end of a run calls `stop()`: zero velocity and LEDs off.
 """
 
 from __future__ import annotations
 
+import contextlib
 import math
 import time
 from typing import Protocol
@@ -26,6 +29,7 @@ from server.hardware.safety import (
     VelocityLimiter,
     Watchdog,
 )
+from server.hardware.silence import SILENCE_LIMITS, SensorSilenceWatchdog, SilenceLimits
 from server.sim import Pose2D
 from server.sim.registry import get_robot
 from server.sim.robots.base import Direction
@@ -39,6 +43,11 @@ LEDS_TOPIC = "Leds"  # the CrowBot's LED topic (firmware); LEDs off at every end
 
 class RobotLost(SimulationError):
     """The connection to the robot is gone; the message says how."""
+
+
+class RobotSilent(RobotLost):
+    """A sensor topic the run depends on stopped arriving; the message names it and for how
+    long (server/hardware/silence.py)."""
 
 
 class RobotLink(Protocol):
@@ -55,6 +64,10 @@ class RobotLink(Protocol):
     def take_received(self) -> list[tuple[str, object, float]]:
         """(topic, message, monotonic receive time [s]) since the last call."""
         ...
+
+    # Optional: `publishes` (a collection of topic names the robot sends). A link that has it
+    # has those topics watched for silence from the start of a run; one without it has each
+    # topic watched from its first message.
 
 
 class _Bench:
@@ -80,6 +93,7 @@ class HardwareRobot:
         limits: MotionLimits,
         watchdog_s: float = DEFAULT_WATCHDOG_S,
         clock=time.monotonic,
+        silence_limits: SilenceLimits = SILENCE_LIMITS,
     ) -> None:
         self.robot = get_robot(robot_id)
         self.world = _Bench()
@@ -99,6 +113,11 @@ class HardwareRobot:
         }  # fmt: skip
         self._zero_sent = False
         self.commands_sent = 0
+        self._sensor_rates_hz = {
+            t.name: t.rate_hz for t in self.topics if t.direction is Direction.PUBLISH
+        }
+        self.silence_limits = silence_limits
+        self.silence: SensorSilenceWatchdog | None = None  # made by reset()
 
     # ------------------------------------------------------------------ what a Run reads
     @property
@@ -119,6 +138,13 @@ class HardwareRobot:
     def reset(self, seed: int | None = None) -> list[Published]:
         self._started_s = self._clock()
         self.watchdog = Watchdog(self.watchdog.timeout_s)
+        publishes = getattr(self.link, "publishes", None)
+        watched = {
+            name: rate
+            for name, rate in self._sensor_rates_hz.items()
+            if publishes is not None and name in publishes
+        }
+        self.silence = SensorSilenceWatchdog(watched, self._started_s, self.silence_limits)
         return []
 
     def drain_events(self) -> list:
@@ -157,11 +183,20 @@ class HardwareRobot:
         self._time_s += dt_s
         started = self._started_s if self._started_s is not None else self._clock()
         published = []
+        silence = self.silence
+        if silence is None:
+            silence = self.silence = SensorSilenceWatchdog({}, started, self.silence_limits)
         for topic, message, received_s in self.link.take_received():
             time_s = min(self._time_s, max(0.0, received_s - started))
             self._latest[topic] = message
             published.append(Published(topic, time_s, message))
+            if topic not in silence.bounds_s and topic in self._sensor_rates_hz:
+                silence.watch(topic, self._sensor_rates_hz[topic], received_s)
+            silence.heard(topic, received_s)
         now = self._clock()
+        if (silent := silence.check(now)) is not None:
+            self._stop_wheels()
+            raise RobotSilent(silent.sentence)
         if self.watchdog.expired(now) and not self._zero_sent:
             self._send_zero()
         return published
@@ -182,6 +217,13 @@ class HardwareRobot:
                 self.link.send(LEDS_TOPIC, msg_type(data=[0, 0, 0]))
         except RobotLost:  # gone in between: nothing left to stop
             pass
+
+    def _stop_wheels(self) -> None:
+        """Zero velocity if the link still takes writes; the run's end sends it again."""
+        if not self.link.connected:
+            return
+        with contextlib.suppress(Exception):  # the run ends either way; stop() tries again
+            self._send_zero()
 
     def _send_zero(self) -> None:
         for topic in self._velocity_topics:

@@ -10,6 +10,7 @@ import time
 
 import pytest
 
+from sandbox.msgs.geometry_msgs import Twist
 from sandbox.msgs.std_msgs import Int32
 from sandbox.protocol import Clock
 from server.hardware.backend import HardwareRobot
@@ -43,11 +44,14 @@ class FakeCrowBot:
         self._received: list[tuple[str, object, float]] = []
         self._lock = threading.Lock()
         self._stop = threading.Event()
+        self.frozen = threading.Event()
         self._thread = threading.Thread(target=self._publish, daemon=True)
         self._thread.start()
 
     def _publish(self) -> None:
         while not self._stop.wait(0.05):
+            if self.frozen.is_set():
+                continue  # the firmware stalled: the socket stays open, nothing arrives
             with self._lock:
                 self._received.append(("Distance", Int32(data=42), time.monotonic()))
 
@@ -126,6 +130,34 @@ def test_a_lost_connection_ends_the_run_with_that_reason(tmp_path, launcher, rob
     assert result.state is RunState.FAILED
     assert result.reason == "failed: robot disconnected"
     assert result.duration_s < 3
+
+
+def test_a_robot_that_stops_sending_ends_the_run_and_is_stopped(tmp_path, launcher, robot):
+    backend = HardwareRobot("crowbot", robot, LIMITS)
+    run = Run(spec(DRIVER, duration_s=10.0), launcher, tmp_path / "run", backend=backend)
+    frozen_at: list[float] = []
+
+    def freeze_once_driving() -> None:
+        deadline = time.monotonic() + 20.0
+        while not any(m.linear.x > 0.1 for _, m in controls_sent()):
+            if time.monotonic() > deadline:
+                return
+            time.sleep(0.01)
+        frozen_at.append(time.monotonic())
+        robot.frozen.set()
+
+    def controls_sent() -> list[tuple[float, object]]:
+        return [(t, m) for t, topic, m in list(robot.sent) if topic == "Control"]
+
+    threading.Thread(target=freeze_once_driving, daemon=True).start()
+    result = run.execute()
+    assert result.state is RunState.FAILED
+    assert result.reason == "failed: robot stopped sending Distance for 0.3 s"
+    # Zero velocity went out within the bound (300 ms after the last Distance) plus a few polls.
+    sent = [(t, m) for t, m in controls_sent() if t > frozen_at[0]]
+    stops = [t for t, m in sent if m == Twist()]
+    assert stops and 0.2 <= stops[0] - frozen_at[0] <= 0.45
+    assert not [t for t, m in sent if m.linear.x and t > stops[0]]  # nothing moved it after
 
 
 def test_a_real_robot_needs_the_realtime_clock(tmp_path, launcher, robot):

@@ -10,7 +10,7 @@ import pytest
 pytest.importorskip("serial", reason="CreateLink needs pyserial")
 
 from sandbox.msgs.geometry_msgs import Twist, Vector3
-from server.hardware.backend import HardwareRobot, RobotLost
+from server.hardware.backend import HardwareRobot, RobotLost, RobotSilent
 from server.hardware.create import oi
 from server.hardware.create.link import CreateLink
 from server.hardware.safety import MotionLimits
@@ -75,6 +75,38 @@ def test_a_silent_create_ends_the_run_with_the_drivers_sentence():
             wait_until(lambda: not link.connected, 2, "the link noticed the silent Create")
             with pytest.raises(RobotLost, match="no sensor frame from the Create"):
                 robot.step(0.02)
+        finally:
+            link.close()
+
+
+def test_a_create_whose_stream_stops_ends_the_run_within_the_silence_bound():
+    with CreateEmulator() as emulator:
+        link = CreateLink(emulator.port)  # the driver's own silence timeout: 0.5 s
+        link.open()
+        try:
+            sent = []
+            send = link.send
+            link.send = lambda topic, message: (sent.append(message), send(topic, message))
+            robot = HardwareRobot("turtlebot", link, LIMITS)
+            robot.reset()
+            robot.apply("cmd_vel", Twist(linear=Vector3(x=0.2)))
+            robot.step(0.02)
+            robot.apply("cmd_vel", Twist(linear=Vector3(x=0.2)))
+            assert sent[-1].linear.x > 0
+            emulator.go_silent()
+            silent_from = time.monotonic()
+            with pytest.raises(RobotSilent) as ended:
+                while time.monotonic() - silent_from < 2.0:
+                    robot.step(0.005)
+                    time.sleep(0.005)
+            caught_after_s = time.monotonic() - silent_from
+            assert str(ended.value) in (
+                "robot stopped sending odom for 0.3 s",
+                "robot stopped sending odom for 0.4 s",
+            )
+            assert caught_after_s < 0.45  # before the driver's own 0.5 s silence timeout
+            assert link.connected  # the link still takes writes: the zero went out
+            assert sent[-1] == Twist()
         finally:
             link.close()
 

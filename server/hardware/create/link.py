@@ -22,7 +22,7 @@ import time
 from collections import deque
 
 from server.hardware.create.driver import CreateDriver, CreateState
-from server.hardware.create.topics import TOPIC_CMD_VEL
+from server.hardware.create.topics import TOPIC_BUMPER, TOPIC_CMD_VEL, TOPIC_ODOM
 
 INBOX_MAX = 1000  # messages waiting for a run: 25 s of odom + bumper at 20 Hz; older ones go
 
@@ -56,6 +56,11 @@ class CreateLink:
         if self.connected:
             return ""
         return self.driver.problem or f"the Create driver is {self.driver.state.value}"
+
+    @property
+    def publishes(self) -> frozenset[str]:
+        """The topics the driver publishes (watched for silence during a run)."""
+        return frozenset({TOPIC_ODOM, TOPIC_BUMPER})
 
     def send(self, topic: str, message: object) -> None:
         if topic != TOPIC_CMD_VEL:

@@ -43,6 +43,11 @@ class RosserialLink:
         # The session closes before the hub hears of it: ask the connection itself.
         return not self._lost and self.connection.connected
 
+    @property
+    def publishes(self) -> frozenset[str]:
+        """The topics the robot advertised and RoboDojo accepted (watched for silence)."""
+        return frozenset(self.connection.session.publishers)
+
     def send(self, topic: str, message: object) -> None:
         try:
             self.connection.send(topic, message)
