@@ -4,14 +4,15 @@ simulated robot of that kind, so the code that ran in simulation runs unchanged.
     robot = HardwareRobot("crowbot", link, limits)       # link: a connected robot (RobotLink)
     run = Run(spec, launcher, out_dir, backend=robot)    # spec.clock must be realtime
 
-It offers the part of `Simulation`'s interface a Run uses (topics, apply, step, state, ...):
-`step()` hands over what the robot sent since the last call, timed on the run's clock;
-`apply()` passes commands through the safety layer (server/hardware/safety.py) before the link.
-The watchdog runs in `step()`: a node that stops commanding for 500 ms stops the robot. When
-the link drops, `step()` raises `RobotLost` and the run ends "failed: robot disconnected"; when
-a sensor topic goes silent past its bound (server/hardware/silence.py), `step()` sends zero
-velocity and raises `RobotSilent`: "failed: robot stopped sending Distance for 0.3 s".
-Every end of a run calls `stop()`: zero velocity and LEDs off.
+It implements `server.sim.backend.RobotBackend`, the protocol `Simulation` implements too, so a
+Run drives either without asking which. `step()` hands over what the robot sent since the last
+call, timed on the run's clock; `apply()` passes commands through the safety layer
+(server/hardware/safety.py) before the link. The watchdog runs in `step()`: a node that stops
+commanding for 500 ms stops the robot. When the link drops, `step()` raises `RobotLost` and the
+run ends "failed: robot disconnected"; when a sensor topic goes silent past its bound
+(server/hardware/silence.py), `step()` sends zero velocity and raises `RobotSilent`: "failed:
+robot stopped sending Distance for 0.3 s". Every end of a run calls `stop()`: zero velocity and
+LEDs off.
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ from __future__ import annotations
 import contextlib
 import math
 import time
-from typing import Protocol
+from typing import TYPE_CHECKING, Protocol
 
 from sandbox.msgs.geometry_msgs import Twist, Vector3
 from server.hardware.safety import (
@@ -36,9 +37,15 @@ from server.sim.robots.base import Direction
 from server.sim.simulation import Published, SimulationError
 from server.sim.state import RobotState
 
+if TYPE_CHECKING:
+    from server.sim.robots.base import TopicSpec
+    from server.sim.simulation import SimEvent
+    from server.sim.world import LightSource
+
 POLL_S = 0.005  # [s] how often a realtime run looks for the robot's messages (200 Hz)
 NO_BOUNDS = (-math.inf, -math.inf, math.inf, math.inf)  # a lab bench has no map edges we know
 LEDS_TOPIC = "Leds"  # the CrowBot's LED topic (firmware); LEDs off at every end
+_BENCH_ORIGIN = Pose2D(0.0, 0.0, 0.0)  # frozen, so one instance serves every robot
 
 
 class RobotLost(SimulationError):
@@ -82,7 +89,9 @@ class _Bench:
 
 
 class HardwareRobot:
-    """Duck-types `server.sim.Simulation` for a Run (see the module docstring)."""
+    """A real robot as a `RobotBackend` (server/sim/backend.py; see the module docstring). It
+    does not inherit the protocol, so a member it lacked would fail the conformance test
+    (tests/hardware/test_backend_protocol.py) instead of quietly returning None."""
 
     is_hardware = True
 
@@ -97,10 +106,9 @@ class HardwareRobot:
     ) -> None:
         self.robot = get_robot(robot_id)
         self.world = _Bench()
-        self.lights = ()
+        self.lights: tuple[LightSource, ...] = ()
         self.link = link
         self.state = RobotState()  # the true pose is unknown on a bench: stays at the origin
-        self.odometry_origin = Pose2D(0.0, 0.0, 0.0)
         self.limiter = VelocityLimiter(limits)
         self.watchdog = Watchdog(watchdog_s)
         self._clock = clock
@@ -121,8 +129,13 @@ class HardwareRobot:
 
     # ------------------------------------------------------------------ what a Run reads
     @property
-    def topics(self):
+    def topics(self) -> tuple[TopicSpec, ...]:
         return self.robot.topics()
+
+    @property
+    def odometry_origin(self) -> Pose2D:
+        """Where the robot's odometry starts: the origin, as a bench has no map."""
+        return _BENCH_ORIGIN
 
     @property
     def time_s(self) -> float:
@@ -147,8 +160,8 @@ class HardwareRobot:
         self.silence = SensorSilenceWatchdog(watched, self._started_s, self.silence_limits)
         return []
 
-    def drain_events(self) -> list:
-        return []
+    def drain_events(self) -> list[SimEvent]:
+        return []  # contacts and bounds are the simulator's to see
 
     def read(self, topic: str) -> object | None:
         return self._latest.get(topic)

@@ -112,7 +112,8 @@ def _check_finite(message: object, path: str) -> None:
 
 
 class Simulation:
-    """One robot in one world. See the module docstring for the contract."""
+    """One robot in one world, a `RobotBackend` (server/sim/backend.py). See the module
+    docstring for the contract."""
 
     def __init__(
         self,
