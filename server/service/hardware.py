@@ -29,6 +29,7 @@ import threading
 import time
 from collections.abc import Callable
 
+from server.hardware.health import LinkHealth, RobotHealth, assess
 from server.hardware.queue import RobotQueue, SlotState
 from server.hardware.rosserial import Refusal, RobotConnection, RosserialHandler, RosserialServer
 from server.hardware.rosserial.link import RosserialLink
@@ -160,7 +161,7 @@ class HardwareHub(RosserialHandler):
             entry = inventory.by_address(db, "rosserial", address)
             known = entry is not None
             name, kind = (entry.name, entry.kind) if known else (address, None)
-        problems = list(robot.problems)
+        problems: list[str] = []  # the session's own are read live (RosserialLink.problems)
         if not known:
             problems.append(
                 f"a robot connected from {address}, which no inventory entry has: register it "
@@ -179,7 +180,8 @@ class HardwareHub(RosserialHandler):
             robot.stop()
             return
         with self._lock:
-            self._problems[name] = problems
+            # An unregistered robot has no link to read its session's problems from later.
+            self._problems[name] = problems if known else problems + list(robot.problems)
             self._conflicts.pop(name, None)
             if known:
                 old = self._links.get(name)
@@ -262,19 +264,29 @@ class HardwareHub(RosserialHandler):
                 )
             return queue
 
-    def connection_state(self, name: str) -> str:
+    def health(self, name: str) -> RobotHealth:
+        """Connected / syncing / stale / disconnected, last heard, problems (health.py): from
+        what the link knows now, so a clean handshake clears what it explains."""
         with self._lock:
             link = self._links.get(name)
             conflict = self._conflicts.get(name)
-        if link is not None and link.connected:
             problems = list(self._problems.get(name) or [])
-            if conflict:
-                problems.append(conflict)
-            return (
-                "connected" if not problems else "connected with problems: " + "; ".join(problems)
-            )
-        return "not connected"
+        if link is None or not link.connected:
+            return assess(None)
+        problems += getattr(link, "problems", [])
+        if conflict:
+            problems.append(conflict)
+        report = getattr(link, "health", None)
+        return assess(report() if report is not None else LinkHealth(True, None), problems)
+
+    def connection_state(self, name: str) -> str:
+        return self.health(name).sentence
 
     def problems(self) -> dict[str, list[str]]:
         with self._lock:
-            return {name: list(p) for name, p in self._problems.items() if p}
+            found = {name: list(p) for name, p in self._problems.items() if p}
+            links = list(self._links.items())
+        for name, link in links:
+            if link.connected and (live := getattr(link, "problems", [])):
+                found[name] = found.get(name, []) + live
+        return found

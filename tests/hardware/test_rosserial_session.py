@@ -273,6 +273,31 @@ def test_sync_is_lost_without_time_requests_then_the_silent_link_is_closed() -> 
     assert session.state is SessionState.CLOSED
 
 
+def test_the_second_sync_warning_says_the_robot_did_ask_before() -> None:
+    session = negotiated(sync_timeout_s=15.0, idle_timeout_s=100.0)
+    session.receive_data(distance_frame(1), T0 + 1.0)
+    (first,) = session.poll(T0 + 15.1)
+    assert first.reason.startswith("lost sync with the robot")
+    session.receive_data(distance_frame(2), T0 + 20.0)  # data, but no time request
+    (second,) = session.poll(T0 + 30.2)
+    assert isinstance(second, SyncLost)
+    assert "never asked" not in second.reason
+    assert second.reason.startswith("still no sync with the robot: its last time request came 30 s")
+
+
+def test_frames_sent_before_the_topics_are_advertised_are_no_problem_once_they_are() -> None:
+    session = started()
+    session.data_to_send()
+    # ros_lib after a reconnection: it publishes before it answers the topic request.
+    session.receive_data(distance_frame(1), T0 + 0.01)
+    assert any("Tried to publish before configured, topic id 125" in p for p in session.problems)
+    session.receive_data(b"".join(negotiation_frames()), T0 + 0.02)
+    assert session.problems == []  # the clean handshake explained it
+    # A frame on an id the robot never advertised stays a problem.
+    session.receive_data(ros_lib_frame(160, Int32(7).serialize()), T0 + 0.03)
+    assert any("topic id 160" in p for p in session.problems)
+
+
 def test_regular_time_requests_keep_the_sync() -> None:
     session = negotiated(sync_timeout_s=15.0)
     for second in range(0, 60, 3):

@@ -12,6 +12,7 @@ from pydantic import Field, field_validator
 
 from server.api.auth import Caller, instructor
 from server.api.schemas import Strict
+from server.hardware.health import assess
 from server.hardware.safety import DEFAULT_WATCHDOG_S, MotionLimits
 from server.sim import get_robot
 from server.store import robots as inventory
@@ -65,6 +66,7 @@ def default_limits(kind: str) -> dict:
 
 def robot_out(entry: RobotEntry, request: Request) -> dict:
     hub = getattr(request.app.state, "hardware", None)
+    health = hub.health(entry.name) if hub else assess(None)
     return {
         "id": entry.id,
         "name": entry.name,
@@ -75,7 +77,8 @@ def robot_out(entry: RobotEntry, request: Request) -> dict:
         "limits": entry.limits,
         "watchdog_s": entry.watchdog_s,
         "in_service": entry.in_service,
-        "connection": hub.connection_state(entry.name) if hub else "not connected",
+        "connection": health.sentence,
+        "health": health.as_dict(),
     }
 
 

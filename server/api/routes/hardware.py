@@ -41,6 +41,7 @@ def robots(request: Request, caller: Caller = Depends(current_user)) -> dict:
         queue = hub.queue(entry.name)
         described = queue.describe(now)
         mine = queue.position(caller.id)
+        health = hub.health(entry.name)
         if not caller.is_instructor:  # students see positions, not who holds them
             for place in described["places"]:
                 place.pop("user_id")
@@ -50,7 +51,8 @@ def robots(request: Request, caller: Caller = Depends(current_user)) -> dict:
                 "name": entry.name,
                 "kind": entry.kind,
                 "in_service": entry.in_service,
-                "connection": hub.connection_state(entry.name),
+                "connection": health.sentence,
+                "health": health.as_dict(),
                 "queue": described,
                 "my_position": mine,
                 "my_estimated_wait_s": (

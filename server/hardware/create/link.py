@@ -23,6 +23,7 @@ from collections import deque
 
 from server.hardware.create.driver import CreateDriver, CreateState
 from server.hardware.create.topics import TOPIC_BUMPER, TOPIC_CMD_VEL, TOPIC_ODOM
+from server.hardware.health import LinkHealth
 
 INBOX_MAX = 1000  # messages waiting for a run: 25 s of odom + bumper at 20 Hz; older ones go
 
@@ -40,6 +41,7 @@ class CreateLink:
         self.driver = CreateDriver(port, on_message=self._push, **options)
         self._inbox: deque[tuple[str, object, float]] = deque(maxlen=inbox_max)
         self._lock = threading.Lock()
+        self._heard_s: float | None = None  # [s] monotonic, the latest message
 
     def open(self) -> None:
         self.driver.open()
@@ -56,6 +58,16 @@ class CreateLink:
         if self.connected:
             return ""
         return self.driver.problem or f"the Create driver is {self.driver.state.value}"
+
+    def health(self) -> LinkHealth:
+        """In sync while frames stream (or only just stopped), and the last message's time."""
+        state = self.driver.state
+        return LinkHealth(state in (CreateState.STREAMING, CreateState.SILENT), self._heard_s)
+
+    @property
+    def problems(self) -> list[str]:
+        problem = self.driver.problem
+        return [problem] if problem else []
 
     @property
     def publishes(self) -> frozenset[str]:
@@ -82,5 +94,7 @@ class CreateLink:
             self._inbox.clear()
 
     def _push(self, topic: str, message: object) -> None:
+        now_s = time.monotonic()
         with self._lock:
-            self._inbox.append((topic, message, time.monotonic()))
+            self._inbox.append((topic, message, now_s))
+            self._heard_s = now_s

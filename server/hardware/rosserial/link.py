@@ -18,8 +18,9 @@ import time
 from collections import deque
 
 from server.hardware.backend import RobotLost
+from server.hardware.health import LinkHealth
 from server.hardware.rosserial.server import RobotConnection
-from server.hardware.rosserial.session import RobotDisconnected
+from server.hardware.rosserial.session import RobotDisconnected, SessionState
 
 INBOX_MAX = 1000  # messages waiting for a run: ~10 s of the CrowBot's topics; older ones go
 LOG_LINES_KEPT = 200  # per robot, for the instructor
@@ -42,6 +43,18 @@ class RosserialLink:
     def connected(self) -> bool:
         # The session closes before the hub hears of it: ask the connection itself.
         return not self._lost and self.connection.connected
+
+    def health(self) -> LinkHealth:
+        """In sync (READY, its time requests answered) and when the robot was last heard."""
+        connection = self.connection
+        session = connection.session
+        synced = self.connected and session.synced and session.state is SessionState.READY
+        return LinkHealth(synced, connection.last_heard_s)
+
+    @property
+    def problems(self) -> list[str]:
+        """The session's problems now (a clean handshake clears those it explains)."""
+        return self.connection.problems
 
     @property
     def publishes(self) -> frozenset[str]:

@@ -154,7 +154,7 @@ class RosserialSession:
         self.publishers: dict[str, RobotTopic] = {}  # robot -> host, by topic name
         self.subscribers: dict[str, RobotTopic] = {}  # host -> robot, by topic name
         self._by_id: dict[int, RobotTopic] = {}  # publishers by the robot's topic id
-        self.problems: list[str] = []
+        self._problems: dict[str, str] = {}  # key -> sentence, for the instructor
         self.stats = SessionStats()
         self.synced = False  # a time request has been answered since the last topic request
         self._outbox = bytearray()
@@ -162,6 +162,7 @@ class RosserialSession:
         self._foreign_versions_seen = 0
         self._once: set[str] = set()
         self._started_s = self._last_rx_s = self._last_sync_s = 0.0
+        self.last_time_request_s: float | None = None  # [s] monotonic, the robot's latest
         self._last_topic_info_s = self._last_request_s = 0.0
         self._rate_window_s = 0.0
         self._rate_count = 0
@@ -188,6 +189,13 @@ class RosserialSession:
         self._transition(SessionState.CLOSED)
         self.close_reason = reason
         return [Closed(reason)]
+
+    @property
+    def problems(self) -> list[str]:
+        """What the instructor should know, each once. Frames on a topic id sent before the
+        robot advertised it are forgotten once it does (ros_lib publishes before it answers a
+        reconnection's topic request): a clean handshake clears them."""
+        return list(self._problems.values())
 
     @property
     def drops(self) -> Counter[str]:
@@ -243,6 +251,13 @@ class RosserialSession:
                     f"lost sync with the robot (no time request for {limits.sync_timeout_s:.0f} "
                     "s); requesting topics again"
                 )
+            elif self.last_time_request_s is not None:
+                reason = (
+                    "still no sync with the robot: its last time request came "
+                    f"{now_s - self.last_time_request_s:.0f} s ago and it has not answered the "
+                    "topic request since (frozen firmware or a stalled WiFi link?); requesting "
+                    "topics again"
+                )
             else:
                 reason = (
                     "unable to sync with the robot (it never asked for the time); possible link "
@@ -281,7 +296,7 @@ class RosserialSession:
         if topic_id == TopicId.TIME:
             self.stats.time_requests += 1
             self.synced = True
-            self._last_sync_s = now_s
+            self._last_sync_s = self.last_time_request_s = now_s
             secs, nsecs = divmod(self._clock_ns(), NS_PER_S)
             self._queue(encode_frame(TopicId.TIME, TimeMessage(RosTime(secs, nsecs)).serialize()))
             return []
@@ -362,6 +377,8 @@ class RosserialSession:
         )
         table = self.publishers if direction is Direction.PUBLISHES else self.subscribers
         if table.get(name) == topic:
+            if direction is Direction.PUBLISHES:
+                self._forget_problem(f"unknown-id:{topic.topic_id}")
             return []  # advertised again after a new topic request: nothing changed
         old = table.get(name)
         if old is not None and direction is Direction.PUBLISHES:
@@ -369,6 +386,7 @@ class RosserialSession:
         table[name] = topic
         if direction is Direction.PUBLISHES:
             self._by_id[topic.topic_id] = topic
+            self._forget_problem(f"unknown-id:{topic.topic_id}")
         return [TopicRegistered(topic)]
 
     def _refusal(self, info: TopicInfo) -> str | None:
@@ -479,8 +497,13 @@ class RosserialSession:
             return []
         if len(self._once) < self.limits.max_problems:
             self._once.add(key)
-            self.problems.append(text)
+            self._problems[key] = text
         return [Problem(text)]
+
+    def _forget_problem(self, key: str) -> None:
+        """The handshake explained it: drop it, and report it again if it comes back."""
+        if self._problems.pop(key, None) is not None:
+            self._once.discard(key)
 
     def _require_open(self, call: str) -> None:
         if self.state is SessionState.CONNECTING:
