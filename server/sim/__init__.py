@@ -1,7 +1,9 @@
 """The pure simulation core: robots, worlds, sensors and physics. No I/O, no wall clock.
 
 `__all__` is the public surface: what notebooks, tests and the run engine may import from
-`server.sim` itself. Anything else lives in a submodule and may change without notice.
+`server.sim` itself. Anything else lives in a submodule and may change without notice. Running a
+step-API controller in-process is deliberately not here: it is `server.sim.unsandboxed`, a name
+that says what it is.
 """
 
 from server.sim.backend import RobotBackend, WorldView
