@@ -12,7 +12,9 @@ commanding for 500 ms stops the robot. When the link drops, `step()` raises `Rob
 run ends "failed: robot disconnected"; when a sensor topic goes silent past its bound
 (server/hardware/silence.py), `step()` sends zero velocity and raises `RobotSilent`: "failed:
 robot stopped sending Distance for 0.3 s". Every end of a run calls `stop()`: zero velocity and
-LEDs off.
+LEDs off. What the safety layer sent is recorded beside the student's command: `Control_applied`
+(the Twist on the wire) and, when something changed it, `Control_limit` (which: the MotionLimits
+fields as "max_linear_m_s,max_linear_accel_m_s2", or "watchdog", "stop").
 """
 
 from __future__ import annotations
@@ -20,9 +22,11 @@ from __future__ import annotations
 import contextlib
 import math
 import time
+from collections import deque
 from typing import TYPE_CHECKING, Protocol
 
 from sandbox.msgs.geometry_msgs import Twist, Vector3
+from sandbox.msgs.std_msgs import String
 from server.hardware.safety import (
     DEFAULT_WATCHDOG_S,
     MotionLimits,
@@ -45,6 +49,14 @@ if TYPE_CHECKING:
 POLL_S = 0.005  # [s] how often a realtime run looks for the robot's messages (200 Hz)
 NO_BOUNDS = (-math.inf, -math.inf, math.inf, math.inf)  # a lab bench has no map edges we know
 LEDS_TOPIC = "Leds"  # the CrowBot's LED topic (firmware); LEDs off at every end
+# Recorded beside the student's command (Control, cmd_vel): what the safety layer sent the robot
+# (geometry_msgs/Twist on "<topic>_applied") and, when something changed it, why (std_msgs/String
+# on "<topic>_limit": the MotionLimits fields, "not_finite", "watchdog" or "stop").
+APPLIED_SUFFIX = "_applied"
+LIMIT_SUFFIX = "_limit"
+WATCHDOG_LIMIT = "watchdog"  # the node stopped commanding: zero sent
+STOP_LIMIT = "stop"  # the run ended or the emergency stop: zero sent
+APPLIED_KEPT = 1000  # applied commands waiting for step(): ~10 s at 100 Hz; older ones go
 _BENCH_ORIGIN = Pose2D(0.0, 0.0, 0.0)  # frozen, so one instance serves every robot
 
 
@@ -126,6 +138,8 @@ class HardwareRobot:
         }
         self.silence_limits = silence_limits
         self.silence: SensorSilenceWatchdog | None = None  # made by reset()
+        # (topic, Twist sent, limits that changed it), published by step() (any thread adds).
+        self._applied: deque[tuple[str, Twist, tuple[str, ...]]] = deque(maxlen=APPLIED_KEPT)
 
     # ------------------------------------------------------------------ what a Run reads
     @property
@@ -179,7 +193,10 @@ class HardwareRobot:
                 linear=Vector3(x=sent.linear_m_s), angular=Vector3(z=sent.angular_rad_s)
             )
             self._zero_sent = sent == Velocity()
-        self.link.send(topic, message)
+            self.link.send(topic, message)
+            self._applied.append((topic, message, self.limiter.limited_by))
+        else:
+            self.link.send(topic, message)
         self.commands_sent += 1
 
     def press_button(self, pressed: bool) -> None:
@@ -211,8 +228,21 @@ class HardwareRobot:
             self._stop_wheels()
             raise RobotSilent(silent.sentence)
         if self.watchdog.expired(now) and not self._zero_sent:
-            self._send_zero()
+            self._send_zero(WATCHDOG_LIMIT)
+        published += self._take_applied()
         return published
+
+    def _take_applied(self) -> list[Published]:
+        """The commands sent since the last step, as `<topic>_applied` and `<topic>_limit`."""
+        out = []
+        while self._applied:
+            topic, twist, limited_by = self._applied.popleft()
+            out.append(Published(topic + APPLIED_SUFFIX, self._time_s, twist))
+            if limited_by:
+                out.append(
+                    Published(topic + LIMIT_SUFFIX, self._time_s, String(data=",".join(limited_by)))
+                )
+        return out
 
     def take_logs(self) -> list[str]:
         """What the robot logged (rosserial id 7) since the last call, for the run's log."""
@@ -236,10 +266,11 @@ class HardwareRobot:
         if not self.link.connected:
             return
         with contextlib.suppress(Exception):  # the run ends either way; stop() tries again
-            self._send_zero()
+            self._send_zero(STOP_LIMIT)
 
-    def _send_zero(self) -> None:
+    def _send_zero(self, why: str = STOP_LIMIT) -> None:
         for topic in self._velocity_topics:
             self.link.send(topic, Twist())
+            self._applied.append((topic, Twist(), (why,)))
         self.limiter.sent = Velocity()
         self._zero_sent = True

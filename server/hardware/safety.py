@@ -17,6 +17,7 @@ import math
 from dataclasses import dataclass
 
 DEFAULT_WATCHDOG_S = 0.5  # [s] no command for this long -> zero velocity
+NOT_FINITE = "not_finite"  # a NaN or inf asked for: zero sent instead
 
 
 @dataclass(frozen=True, slots=True)
@@ -68,17 +69,36 @@ class VelocityLimiter:
         self.sent = ZERO
         self._sent_at_s: float | None = None
         self.clamped = 0  # commands that asked for more than the robot may do
+        # The MotionLimits fields that changed the last command (NOT_FINITE for a NaN or inf),
+        # in the order applied; empty when it went out as asked.
+        self.limited_by: tuple[str, ...] = ()
 
     def apply(self, wanted: Velocity, now_s: float) -> Velocity:
         limits = self.limits
         linear = _clamp(wanted.linear_m_s, limits.max_linear_m_s)
         angular = _clamp(wanted.angular_rad_s, limits.max_angular_rad_s)
-        if (linear, angular) != (wanted.linear_m_s, wanted.angular_rad_s):
+        changed = [
+            NOT_FINITE if not math.isfinite(asked) else name
+            for asked, got, name in (
+                (wanted.linear_m_s, linear, "max_linear_m_s"),
+                (wanted.angular_rad_s, angular, "max_angular_rad_s"),
+            )
+            if asked != got
+        ]
+        if changed:
             self.clamped += 1
         # The robot starts at rest: the first command ramps from zero too.
         dt = 0.0 if self._sent_at_s is None else max(0.0, now_s - self._sent_at_s)
-        linear = _ramp(self.sent.linear_m_s, linear, limits.max_linear_accel_m_s2 * dt)
-        angular = _ramp(self.sent.angular_rad_s, angular, limits.max_angular_accel_rad_s2 * dt)
+        ramped_linear = _ramp(self.sent.linear_m_s, linear, limits.max_linear_accel_m_s2 * dt)
+        ramped_angular = _ramp(
+            self.sent.angular_rad_s, angular, limits.max_angular_accel_rad_s2 * dt
+        )
+        if ramped_linear != linear:
+            changed.append("max_linear_accel_m_s2")
+        if ramped_angular != angular:
+            changed.append("max_angular_accel_rad_s2")
+        linear, angular = ramped_linear, ramped_angular
+        self.limited_by = tuple(dict.fromkeys(changed))
         self.sent = Velocity(linear, angular)
         self._sent_at_s = now_s
         return self.sent

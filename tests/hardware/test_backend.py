@@ -9,7 +9,9 @@ import threading
 import time
 
 import pytest
+from mcap.reader import make_reader
 
+from sandbox.msgs import get_message_class
 from sandbox.msgs.geometry_msgs import Twist
 from sandbox.msgs.std_msgs import Int32
 from sandbox.protocol import Clock
@@ -102,6 +104,29 @@ def test_a_node_drives_the_robot_through_the_limits_and_it_stops_at_the_end(
     assert any(
         "saw 42" in line for line in (tmp_path / "run/logs/driver.log").read_text().split("\n")
     )
+
+
+def test_the_applied_command_is_recorded_beside_the_students_with_its_limit(
+    tmp_path, launcher, robot
+):
+    backend = HardwareRobot("crowbot", robot, LIMITS)
+    result = Run(spec(DRIVER), launcher, tmp_path / "run", backend=backend).execute()
+    assert result.state is RunState.FINISHED, result.reason
+    recorded: dict[str, list[object]] = {}
+    with (tmp_path / "run/recording.mcap").open("rb") as stream:
+        for schema, channel, message in make_reader(stream).iter_messages():
+            cls = get_message_class(schema.name)
+            recorded.setdefault(channel.topic, []).append(cls.deserialize(message.data))
+    asked = [m.linear.x for m in recorded["/Control"]]
+    applied = [m.linear.x for m in recorded["/Control_applied"]]
+    assert asked.count(5.0) >= 10  # the student's raw command
+    assert max(applied) == pytest.approx(0.2) and applied[0] < 0.2  # clamped and ramped
+    limits = [m.data for m in recorded["/Control_limit"]]
+    # Before the node's first command the watchdog held the robot at zero; then the step from
+    # rest was both clamped and ramped, and once at speed only clamped.
+    assert limits[0] == "watchdog"
+    assert limits[1] == "max_linear_m_s,max_linear_accel_m_s2"
+    assert limits[-1] == "max_linear_m_s"
 
 
 def test_the_watchdog_stops_the_robot_when_the_node_goes_quiet(tmp_path, launcher, robot):

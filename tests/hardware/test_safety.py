@@ -31,6 +31,18 @@ def test_a_step_to_full_speed_is_ramped_by_the_acceleration_limit():
     assert limiter.apply(Velocity(-0.3, 0.0), 0.25).linear_m_s == pytest.approx(0.15)
 
 
+def test_the_limiter_says_which_limits_changed_a_command():
+    limiter = VelocityLimiter(LIMITS)
+    limiter.apply(Velocity(0.0, 0.0), 0.0)
+    assert limiter.limited_by == ()
+    limiter.apply(Velocity(5.0, 0.0), 0.1)  # too fast, and a step from rest
+    assert limiter.limited_by == ("max_linear_m_s", "max_linear_accel_m_s2")
+    limiter.apply(Velocity(0.3, 1.0), 10.0)  # reachable in 9.9 s: as asked
+    assert limiter.limited_by == ()
+    limiter.apply(Velocity(math.nan, 1.0), 10.1)
+    assert limiter.limited_by == ("not_finite", "max_linear_accel_m_s2")
+
+
 @pytest.mark.parametrize("bad", [math.nan, math.inf, -math.inf])
 def test_nan_and_inf_stop_the_robot(bad):
     assert VelocityLimiter(LIMITS).apply(Velocity(bad, bad), 0.0) == Velocity(0.0, 0.0)
