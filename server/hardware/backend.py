@@ -127,10 +127,7 @@ class HardwareRobot:
         self._started_s: float | None = None
         self._time_s = 0.0
         self._latest: dict[str, object] = {}
-        self._velocity_topics = {
-            t.name for t in self.topics if t.direction is Direction.SUBSCRIBE
-            and t.type_name == "geometry_msgs/Twist"
-        }  # fmt: skip
+        self._velocity_topics = set(self.robot.velocity_topics())
         self._zero_sent = False
         self.commands_sent = 0
         self._sensor_rates_hz = {

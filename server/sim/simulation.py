@@ -261,9 +261,8 @@ class Simulation:
 
     def stop(self) -> None:
         """Zero velocity on every velocity (Twist) topic, from the next tick on."""
-        for spec in self.topics:
-            if spec.direction is Direction.SUBSCRIBE and spec.type_name == "geometry_msgs/Twist":
-                self.apply(spec.name, spec.msg_type())
+        for name in self.robot.velocity_topics():
+            self.apply(name, self._topics[name].msg_type())
 
     def take_logs(self) -> list[str]:
         """A simulated robot logs nothing of its own (a real one's firmware does)."""

@@ -163,14 +163,7 @@ def _node_info(sim: Simulation) -> NodeInfo:
     """What a ROS 1 run tells a node about the robot's topics (and the run's goal topic)."""
     topics = [RobotTopic(t.name, t.type_name, str(t.direction), t.rate_hz) for t in sim.topics]
     topics.append(RobotTopic(GOAL_TOPIC, GOAL_TYPE, str(Direction.PUBLISH)))
-    velocity = next(
-        (
-            t.name
-            for t in sim.topics
-            if t.direction is Direction.SUBSCRIBE and t.type_name == "geometry_msgs/Twist"
-        ),
-        None,
-    )
+    velocity = next(iter(sim.robot.velocity_topics()), None)
     return NodeInfo(
         node_name=NODE_NAME,
         robot=sim.robot.id,

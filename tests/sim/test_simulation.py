@@ -9,7 +9,7 @@ from sandbox.msgs.geometry_msgs import Twist, Vector3
 from sandbox.msgs.std_msgs import Bool, Float32, Int16, Int32, Int32MultiArray, String
 from server.sim import EventKind, Pose2D, Simulation, SimulationError
 from server.sim.checks import registry_problems
-from server.sim.registry import UnknownRobotError, robot_ids
+from server.sim.registry import UnknownRobotError, get_robot, robot_ids
 from server.sim.world import WorldError
 
 
@@ -269,3 +269,17 @@ def test_the_odometry_origin_stays_where_the_robot_started():
         sim.step(0.1)
     assert sim.state.pose.x > start.x + 0.2
     assert (sim.odometry_origin.x, sim.odometry_origin.y) == pytest.approx((0.7, 3.1))
+
+
+def test_velocity_topics_are_the_twist_commands_and_stop_zeroes_them():
+    assert {r: get_robot(r).velocity_topics() for r in robot_ids()} == {
+        "crop_rover": ("cmd_vel",),
+        "crowbot": ("Control",),
+        "ir_scout": ("cmd_vel",),
+        "turtlebot": ("cmd_vel",),
+        "turtlebot3": ("cmd_vel",),
+    }
+    sim = Simulation("crowbot", "wall_approach")
+    sim.apply("Control", Twist(linear=Vector3(x=0.1)))
+    sim.stop()
+    assert sim.read("Control").linear.x == 0.0

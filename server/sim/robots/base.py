@@ -14,6 +14,8 @@ from typing import ClassVar, Protocol
 from server.sim.sensors.base import Sensor
 from server.sim.state import RobotState
 
+TWIST_TYPE = "geometry_msgs/Twist"  # the velocity command type of every wheeled robot here
+
 
 class Direction(StrEnum):
     """Seen from the robot: it publishes sensor topics and subscribes to command topics."""
@@ -111,6 +113,13 @@ class RobotModel:
         """Per physics tick, for actuators other than the wheels (servo slew, buzzer timer)."""
         if state.buzzer_on and time_s >= state.buzzer_until_s:
             state.buzzer_on = False
+
+    def velocity_topics(self) -> tuple[str, ...]:
+        """The command topics that take a geometry_msgs/Twist (Control, cmd_vel), in declared
+        order: the one a step API's (v, w) goes to is the first; stopping zeroes them all."""
+        return tuple(
+            name for name, (msg_type, _) in self.commands.items() if msg_type._type == TWIST_TYPE
+        )
 
     def topics(self) -> tuple[TopicSpec, ...]:
         """All topics, publishers first, each with its type and rate."""
