@@ -113,8 +113,9 @@ def add_commands(commands) -> None:
     serve.add_argument(
         "--rosserial-host",
         default=None,
-        help="address the rosserial port listens on: the robots' VLAN/SSID interface (default: "
-        "--host); ros_lib has no authentication, see README 'Network isolation for the bench'",
+        help="address the rosserial port listens on (default 0.0.0.0, all interfaces, whatever "
+        "--host is); name the robots' VLAN/SSID interface or firewall the port: ros_lib has no "
+        "authentication, see README 'Network isolation for the bench'",
     )
     serve.add_argument(
         "--unsafe-no-sandbox",

@@ -46,18 +46,20 @@ class Settings(BaseSettings):
     retry_after_s: int = Field(10, ge=1)  # [s] told to a client that hit a run limit
 
     # Real robots: CrowBots (ros_lib over WiFi) connect to this TCP port; rosserial_python's
-    # 11411 by default; 0 = any free port (tests); -1 = off. ros_lib has no authentication:
-    # a connection from an address no inventory entry has is closed at once (and backed off,
-    # server/hardware/rosserial/limits.py), but addresses can be spoofed on a shared network, so
-    # bind this to the robots' own VLAN/SSID interface (README, "Network isolation for the
-    # bench"). None = the web service's `host` (127.0.0.1 by default: robots on the network
-    # cannot connect until you name their interface), never all interfaces unasked.
+    # 11411 by default; 0 = any free port (tests); -1 = off. It listens on `rosserial_host`,
+    # all interfaces by default, whatever the web service's `host`: the robots are on the bench's
+    # WiFi while the web service is often behind a proxy on 127.0.0.1, and a default that robots
+    # cannot reach (the web host, as before) left benches with robots that never connected.
+    # ros_lib has no authentication: a connection from an address no inventory entry has is
+    # closed at once (and backed off, server/hardware/rosserial/limits.py), but addresses can
+    # be spoofed on a shared network, so name the robots' VLAN/SSID interface here or firewall
+    # the port to their subnet (README, "Network isolation for the bench").
     rosserial_port: int = Field(11411, ge=-1, le=65535)
-    rosserial_host: str | None = None
+    rosserial_host: str = "0.0.0.0"
 
     @property
     def rosserial_bind_host(self) -> str:
-        return self.rosserial_host or self.host
+        return self.rosserial_host
 
     hardware_gate: bool = True  # a hardware run needs the same code to have passed in simulation
     hardware_slot_s: float = Field(300.0, gt=0)  # [s] longest turn on a robot

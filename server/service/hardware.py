@@ -85,6 +85,14 @@ class HardwareHub(RosserialHandler):
                 "--rosserial-host with the address of the robots' VLAN/SSID interface",
                 host,
             )
+        elif host in ("0.0.0.0", "::", ""):
+            log.info(
+                "rosserial listens on all interfaces: only registered robot addresses get a "
+                "session, but addresses can be spoofed; pass --rosserial-host with the robots' "
+                "VLAN/SSID interface or firewall port %d to their subnet (README, 'Network "
+                "isolation for the bench')",
+                server.port,
+            )
 
     def _tick_queues(self) -> None:
         while not self._closing.wait(QUEUE_TICK_S):
