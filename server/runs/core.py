@@ -315,7 +315,7 @@ class RunCore:
                 self.edge.command_from_node(sender, envelope, now_ns)
             else:
                 self.edge.command_trusted(topic, message, native)
-        if self.builtins.listens_to(topic):
+        if self.builtins and self.builtins.listens_to(topic):
             if message is None:
                 message, native = self.dialect.decode(envelope), self.dialect.ros2
             self.builtins.deliver(self, source, topic, message, native)
@@ -407,7 +407,7 @@ class RunCore:
 
     def apply_commands(self) -> None:
         """Take and apply the commands waiting in the inbox (Stop raises RunEnd)."""
-        for command in self.inbox.drain():
+        for command in self.inbox.take_all():
             controls.apply(self, command)
 
     def wait_for_command(self, timeout_s: float) -> None:

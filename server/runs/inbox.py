@@ -9,7 +9,6 @@ from __future__ import annotations
 import contextlib
 import os
 import queue
-from collections.abc import Iterator
 
 from server.runs.commands import RunCommand
 
@@ -32,18 +31,18 @@ class CommandInbox:
         """Readable while a command waits: a sleeping loop can select() on it."""
         return self._signal_r
 
-    def drain(self) -> Iterator[RunCommand]:
-        """The waiting commands, oldest first, one at a time: what is not taken yet (the one
-        before it ended the run) stays queued."""
-        if self._queue.empty():  # the common case, checked without a system call
-            return
+    def take_all(self) -> list[RunCommand]:
+        """The waiting commands, oldest first (none: the common case, without a system call)."""
+        if self._queue.empty():
+            return []
         with contextlib.suppress(BlockingIOError, OSError):
             os.read(self._signal_r, 4096)
+        commands = []
         while True:
             try:
-                yield self._queue.get_nowait()
+                commands.append(self._queue.get_nowait())
             except queue.Empty:
-                return
+                return commands
 
     def wait(self, timeout_s: float) -> RunCommand | None:
         """Block up to `timeout_s` [s] for one command (a paused loop)."""
