@@ -9,9 +9,10 @@ drives it (server/runs/clocks.py) sees only the narrow `ClockedRun` side of it:
     advance_to(time_ns)           step the robot there and route what it published
     tick_s, apply_commands(), wake(slot, now_ns), begin_wake(...), collect_replies(), ...
 
-Nothing that goes wrong in one run escapes `run()`: a node that raises or is killed, a recorder
-that fails, a simulator that raises - each ends this run with a reason and leaves others alone.
-Built-in nodes (server/runs/builtin.py) are handed this core as their `run`.
+Its parts: the sandboxed nodes (node_host.py), the built-ins (builtin_host.py; each is handed
+this core as its `run`), the robot's edge (robot_edge.py), the topic bus (bus.py). Nothing that
+goes wrong in one run escapes `run()`: a node that raises or is killed, a recorder that fails, a
+simulator that raises - each ends this run with a reason and leaves others alone.
 """
 
 from __future__ import annotations
@@ -24,17 +25,7 @@ from pathlib import Path
 
 import sandbox.services  # noqa: F401  # registers the service envelope types the recorder sees
 from sandbox.launcher import Launcher
-from sandbox.node_process import NodeState
-from sandbox.protocol import (
-    Artifact,
-    Envelope,
-    Exited,
-    Finishing,
-    NodeInfo,
-    Outcome,
-    RobotTopic,
-    Yield,
-)
+from sandbox.protocol import Envelope, NodeInfo, RobotTopic
 from sandbox.units import NS_PER_S
 from server.runs import controls
 from server.runs.builtin_host import BuiltinHost
@@ -42,6 +33,7 @@ from server.runs.bus import TopicBus
 from server.runs.dialect import Dialect
 from server.runs.faults import Faults
 from server.runs.inbox import CommandInbox
+from server.runs.node_host import NodeHost
 from server.runs.outputs import RecordingSink, RunOutputs
 from server.runs.recorder import Recorder
 from server.runs.result import RunEnd, RunResult
@@ -85,9 +77,9 @@ class RunCore:
         self._state_lock = threading.Lock()
         self.inbox = CommandInbox()
         self.faults = Faults()
-        self.slots = {node.name: NodeSlot(node) for node in spec.nodes}
-        self._order = list(self.slots.values())  # launch-file order: who wakes first
         self.bus = TopicBus()
+        self.nodes = NodeHost(spec.nodes, self.bus, outputs, self.from_node)
+        self.slots = self.nodes.slots
         self.builtins = BuiltinHost(spec.builtin_nodes, self.dialect.ros_version)
         self._script = [  # (run time [ns], command), soonest first
             (round(at_s * NS_PER_S), command)
@@ -191,43 +183,14 @@ class RunCore:
         )
 
     def start_nodes(self) -> None:
-        for slot in self._order:
-            self.bus.add_node(slot.name)
-            slot.process = self.launcher.start(slot.name)
-        replies = []
-        files = [Artifact(path, data) for path, data in self.spec.files]
-        for slot in self._order:
-            node = slot.spec
-            reply = slot.process.load(
-                node.code, node.filename, node.api, self.node_info(node), files
-            )
-            replies.append((slot, reply))
-        # Every node's subscriptions are known before anything published at start-up is
-        # routed, so launch-file order does not lose a first message (as a latched topic).
-        for slot, reply in replies:
-            if isinstance(reply, Yield):
-                self.bus.declare(slot.name, reply.advertised, reply.subscribed)
-        for slot, reply in replies:
-            self.handle_reply(slot, reply, timed=False)
+        self.nodes.start(self.launcher, self.node_info, self.spec.files)
         self.builtins.start(self)
 
     def finish(self, end_state: RunState, reason: str, wall_s: float) -> RunResult:
         """Stop the robot, end every node, close the recording; the run's last state."""
         if self.edge is not None and self.recorder is not None:
             self.edge.command_zero(self.time_ns)
-        for slot in self._order:
-            finishing = slot.finishing
-            self._end_node(slot, reason)
-            late = slot.exited
-            if finishing and late is not None and end_state is RunState.FINISHED:
-                # What a node did after its control part (figures, files) can still fail it.
-                if late.outcome is Outcome.ERROR and late.error is not None:
-                    slot.log(late.error.traceback.rstrip("\n").split("\n"), self.outputs)
-                    where = f" at line {late.error.line}" if late.error.line else ""
-                    end_state = RunState.FAILED
-                    reason = f"failed: node {slot.name} raised {late.error.type}{where}"
-                elif late.outcome in (Outcome.KILLED, Outcome.CRASHED):
-                    end_state, reason = RunState.FAILED, f"failed: {late.reason}"
+        end_state, reason = self.nodes.end_all(end_state, reason, self.recorder)
         if self.recorder is not None:
             metrics = self.metrics()
             self.recorder.write_json("metrics", metrics)
@@ -254,24 +217,6 @@ class RunCore:
             ros_version=self.dialect.ros_version,
         )
 
-    def _end_node(self, slot: NodeSlot, reason: str) -> None:
-        process = slot.process
-        if process is None:
-            return
-        try:
-            exited = slot.exited or process.shutdown(reason)
-            slot.exited = exited
-            self._collect_logs(slot)
-            if self.recorder is not None and exited.artifacts:
-                self.recorder.write_artifacts(
-                    slot.name, [(a.name, a.data) for a in exited.artifacts]
-                )
-            for note in exited.notes:
-                slot.logs.append(f"[artifacts] {note}")
-        finally:
-            process.close()
-            slot.process = None
-
     def metrics(self) -> dict:
         state = self.sim.state if self.sim is not None else None
         run = {
@@ -281,15 +226,7 @@ class RunCore:
             "clock_wall_s": self.clock_wall_s,
             "ros_version": self.dialect.ros_version,
         }
-        nodes = {}
-        for slot in self._order:
-            summary = slot.metrics.summary()
-            summary["outcome"] = str(slot.exited.outcome) if slot.exited else None
-            summary["dropped_messages"] = (
-                self.bus.dropped(slot.name) if slot.name in self.bus.nodes else 0
-            )
-            nodes[slot.name] = summary
-        return {"run": run, "nodes": nodes}
+        return {"run": run, "nodes": self.nodes.metrics()}
 
     # ----------------------------------------------------------------------------- routing
     def route(
@@ -325,71 +262,6 @@ class RunCore:
             slot.metrics.published += 1
             self.route(slot.name, envelope, sender=slot)
 
-    # ----------------------------------------------------------------------------- nodes
-    def handle_reply(
-        self, slot: NodeSlot, reply: Yield | Finishing | Exited, timed: bool = True
-    ) -> None:
-        """Act on what a node said when it went back to sleep (or ended). `timed`: the reply
-        answers a wake, so its wall time is a step's compute time (not start-up)."""
-        if timed and not slot.finishing:
-            slot.metrics.compute.add(time.perf_counter() - slot.woken_at_wall)
-        self._collect_logs(slot)
-        if isinstance(reply, Yield):
-            self.bus.declare(slot.name, reply.advertised, reply.subscribed)
-            if reply.unsubscribed:
-                self.bus.unsubscribe(slot.name, reply.unsubscribed)
-            self.from_node(slot, reply.published)
-            slot.wake_at_ns = None if reply.wake_at_s is None else round(reply.wake_at_s * NS_PER_S)
-            slot.wake_on = None if reply.wake_on is None else frozenset(reply.wake_on)
-            return
-        self.from_node(slot, reply.published)
-        self.bus.remove_node(slot.name)
-        if isinstance(reply, Finishing):
-            # The node's part in the run is over (its hooks' last messages are routed above);
-            # its figures and files come with its Exited, within the end budget.
-            slot.done, slot.finishing = True, True
-            slot.log([f"[run] node finishing: {reply.reason}"], self.outputs)
-            if all(s.done for s in self._order):
-                raise RunEnd(RunState.FINISHED, "finished: every node ended")
-            return
-        slot.exited, slot.done, slot.finishing = reply, True, False
-        if reply.error is not None:  # the student's traceback belongs in the node's log
-            slot.log(reply.error.traceback.rstrip("\n").split("\n"), self.outputs)
-        if reply.outcome is Outcome.FINISHED:
-            if all(s.done for s in self._order):
-                raise RunEnd(RunState.FINISHED, "finished: every node ended")
-            return
-        if reply.outcome is Outcome.ERROR and reply.error is not None:
-            where = f" at line {reply.error.line}" if reply.error.line else ""
-            raise RunEnd(
-                RunState.FAILED, f"failed: node {slot.name} raised {reply.error.type}{where}"
-            )
-        raise RunEnd(RunState.FAILED, f"failed: {reply.reason}")
-
-    def _collect_logs(self, slot: NodeSlot) -> None:
-        if slot.process is None:
-            return
-        lines = slot.process.logs.take()
-        if lines:
-            slot.log(lines, self.outputs)
-
-    def _is_due(self, slot: NodeSlot, now_ns: int) -> bool:
-        """Is the sleeping node to be woken at `now_ns`: its time has come, or a message it
-        waits for (any, while spinning; or one of its wake_on topics) is there."""
-        if slot.wake_at_ns is not None and slot.wake_at_ns <= now_ns:
-            return True
-        if slot.wake_on is None:
-            return slot.wake_at_ns is None and self.bus.has_pending(slot.name)
-        return self.bus.has_pending_on(slot.name, slot.wake_on)
-
-    def _poll_finishing(self) -> None:
-        """Collect the Exited of nodes that are finishing (or end them past their budget)."""
-        for slot in self._order:
-            if slot.finishing and slot.process is not None:
-                exited = slot.process.poll_finished()
-                if exited is not None:
-                    self.handle_reply(slot, exited)
-
     # ----------------------------------------------------------------------------- the clocks' side
     @property
     def tick_s(self) -> float:
@@ -418,14 +290,7 @@ class RunCore:
 
     def due_nodes(self, now_ns: int) -> list[NodeSlot]:
         """The sleeping nodes to wake at `now_ns`, in launch-file order."""
-        return [
-            slot
-            for slot in self._order
-            if not slot.done
-            and slot.process is not None
-            and slot.process.state is NodeState.SLEEPING
-            and self._is_due(slot, now_ns)
-        ]
+        return self.nodes.due(now_ns)
 
     def next_event_ns(self, *, every_publication: bool) -> int:
         """Run time [ns] of the next thing to happen: the end, a scripted command, a built-in's
@@ -442,14 +307,9 @@ class RunCore:
         ):
             if upcoming is not None:
                 candidates.append(upcoming)
-        listening = False
-        for slot in self._order:
-            if slot.done or slot.computing:
-                continue
-            if slot.wake_at_ns is None or slot.wake_on is not None:
-                listening = True  # a message can wake it before its wake time
-            if slot.wake_at_ns is not None:
-                candidates.append(slot.wake_at_ns)
+        wake_ns, listening = self.nodes.next_wake()
+        if wake_ns is not None:
+            candidates.append(wake_ns)
         if every_publication or listening:
             candidates.append(round(self.sim.next_publication_s() * NS_PER_S))
         return min(candidates)
@@ -475,8 +335,8 @@ class RunCore:
             controls.apply(self, command)
         if self.builtins:
             self.builtins.tick(self)
-        if any(slot.finishing for slot in self._order):
-            self._poll_finishing()
+        if any(slot.finishing for slot in self.nodes.order):
+            self.nodes.poll_finishing()
         self.outputs.log("robot", self.sim.take_logs())  # a real robot's own loginfo
         self.edge.check_in_map()
         if self.time_ns >= self.edge.next_tf_ns:
@@ -485,44 +345,17 @@ class RunCore:
             raise RunEnd(RunState.FAILED, f"failed: {self.recorder.error}")
 
     def wake(self, slot: NodeSlot, now_ns: int) -> None:
-        """Lockstep: wake one node now and handle its reply (a node ended meanwhile by an
-        earlier one's reply is left alone)."""
-        if slot.done:
-            return
-        self.begin_wake(slot, now_ns)
-        self.handle_reply(slot, slot.process.poll_reply(None))
+        """Lockstep: wake a node and handle its reply before anything else happens."""
+        self.nodes.wake(slot, now_ns)
 
     def begin_wake(self, slot: NodeSlot, now_ns: int) -> None:
-        """Wake one node with what waits for it, without waiting for its reply."""
-        deliveries, newest_sensor_s = self.bus.take(slot.name)
-        if newest_sensor_s is not None:
-            slot.newest_sensor_s = newest_sensor_s
-        if slot.last_wake_ns is not None:
-            slot.metrics.period.add((now_ns - slot.last_wake_ns) / NS_PER_S)
-        slot.last_wake_ns = now_ns
-        slot.metrics.wakes += 1
-        slot.woken_at_wall = time.perf_counter()
-        graph = None
-        if slot.graph_version != self.bus.version:
-            graph, slot.graph_version = self.bus.graph_topics(), self.bus.version
-        slot.process.begin_wake(now_ns / NS_PER_S, deliveries, graph)
+        """Realtime: wake a node; its reply is collected when it comes (collect_replies)."""
+        self.nodes.begin_wake(slot, now_ns)
 
     def collect_replies(self) -> bool:
-        """Realtime: handle the replies of computing nodes that have answered; True if any."""
-        replied = False
-        for slot in self._order:
-            if not slot.done and slot.computing:
-                reply = slot.process.poll_reply(0.0)
-                if reply is not None:
-                    self.handle_reply(slot, reply)
-                    replied = True
-        return replied
+        """Realtime: handle the replies that have come; True if any did."""
+        return self.nodes.collect_replies()
 
     def reply_fds(self) -> list[int]:
         """Realtime: fds that become readable when a computing node answers."""
-        return [
-            fd
-            for slot in self._order
-            if not slot.done and slot.computing
-            for fd in slot.process.reply_fds
-        ]
+        return self.nodes.reply_fds()
