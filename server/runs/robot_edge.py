@@ -26,7 +26,7 @@ from server.runs.state import RunState
 from server.runs.tf import tf_message
 from server.sim.backend import RobotBackend
 from server.sim.geometry import yaw_quaternion
-from server.sim.robots.base import CommandError, Direction
+from server.sim.robots.base import CommandError
 from server.sim.simulation import SimulationError
 
 log = logging.getLogger("robodojo.runs")
@@ -35,7 +35,6 @@ GOAL_TOPIC = "goal"  # RViz's "2D Nav Goal" idea: the run publishes the goal pos
 TF_TOPIC = "tf"  # the transform tree, recorded and published to nodes (tf2_ros listens here)
 TF_PERIOD_NS = NS_PER_S // 30  # [ns] /tf recorded at 30 Hz: smooth in Foxglove, small on disk
 MAP_MARGIN_M = 0.5  # [m] beyond the world's bounds by this much, the robot left the map
-TWIST = "geometry_msgs/Twist"
 
 
 class RobotEdge:
@@ -89,14 +88,7 @@ class RobotEdge:
     @property
     def velocity_topic(self) -> str | None:
         """The robot's Twist command topic (Control, cmd_vel), if it has one."""
-        return next(
-            (
-                t.name
-                for t in self.backend.topics
-                if t.direction is Direction.SUBSCRIBE and t.type_name == TWIST
-            ),
-            None,
-        )
+        return next(iter(self.backend.robot.velocity_topics()), None)
 
     # ----------------------------------------------------------------------------- from it
     def from_robot(self, topic: str, message: object, time_s: float, now_ns: int) -> None:
@@ -154,20 +146,17 @@ class RobotEdge:
             self.backend.stop()
         except Exception:  # the end must go on whatever the robot says
             log.exception("run %s: could not stop the robot", self.run_id)
-        for name, (msg_type, _) in self.commands.items():
-            if msg_type._type != TWIST:
-                continue
+        for name in self.backend.robot.velocity_topics():
             try:
-                zero_type, data = self.dialect.zero_command(name, msg_type, now_ns)
+                zero_type, data = self.dialect.zero_command(name, self.commands[name][0], now_ns)
                 self.outputs.record(name, zero_type, now_ns, data)
             except Exception:
                 log.exception("run %s: could not record zero velocity on %s", self.run_id, name)
 
     def stall_motors(self) -> None:
         """Zero on every velocity topic (the stall-motors fault; a real robot's LEDs stay)."""
-        for name, (msg_type, _) in self.commands.items():
-            if msg_type._type == TWIST:
-                self.backend.apply(name, msg_type())
+        for name in self.backend.robot.velocity_topics():
+            self.backend.apply(name, self.commands[name][0]())
 
     # ----------------------------------------------------------------------------- the run's own
     def publish_goal(self, x: float, y: float, yaw: float, now_ns: int) -> None:
