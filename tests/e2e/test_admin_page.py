@@ -107,6 +107,25 @@ def test_instructor_console_in_chromium(web_lab, new_page, screenshots) -> None:
     row = page.get_by_test_id("runs-table").locator(f'tr[data-run-id="{run_id}"]')
     expect(row).to_contain_text("Grace Hopper", timeout=20_000)
     expect(row.get_by_role("link", name="Watch")).to_have_attribute("href", f"/?run={run_id}")
+
+    # The header counts the live runs the section lists: it said "0 active runs" beside one
+    # when its 5 s status poll lagged the list; a status answer made stale on purpose must not
+    # change the count shown beside the listed run.
+    def stale_status(route) -> None:
+        answer = route.fetch()
+        body = answer.json()
+        body["runs"]["active_runs"] = 0
+        route.fulfill(response=answer, json=body)
+
+    page.route("**/api/admin/status", stale_status)
+    with page.expect_response("**/api/admin/status"):  # the stale answer has arrived
+        page.evaluate("() => document.dispatchEvent(new Event('visibilitychange'))")  # poll now
+    listed = page.locator("#live-table tbody tr").count()
+    assert listed >= 1
+    expect(page.locator("#status-summary")).to_contain_text(
+        re.compile(rf"^{listed} active runs? ·")
+    )
+    page.unroute("**/api/admin/status")
     page.screenshot(path=str(screenshots / "admin-runs.png"), full_page=True)
     row.get_by_test_id("run-stop").click()
     expect(row).to_have_count(0, timeout=20_000)

@@ -21,7 +21,7 @@ import {
   timeEl,
 } from "./dom.js";
 import { exerciseTitle, state, subscribe, userName } from "./state.js";
-import { refreshStatus } from "./status.js";
+import { refreshStatus, setListedRuns } from "./status.js";
 
 const LIVE_STATES = ["starting", "running", "paused"]; // the API filters on one state a request
 const ACTIVE = new Set(["created", "starting", "running", "paused", "stopping"]);
@@ -204,6 +204,7 @@ function renderLive(runs) {
     previous = row;
   }
   $("#live-empty").hidden = runs.length > 0;
+  setListedRuns(runs.length);
   $("#live-updated").textContent = `updated ${new Date().toLocaleTimeString()}`;
   if (changed && !firstLive) {
     if (recentOffset === 0) loadRecent();
@@ -356,6 +357,7 @@ export function initRuns() {
 /** The Runs section is shown (true) or hidden (false): polling follows. */
 export function showRuns(visible) {
   liveVisible = visible;
+  if (!visible) setListedRuns(null); // not polled any more: the server's count is fresher
   if (visible) {
     firstLive = true;
     pollLive();

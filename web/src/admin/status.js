@@ -8,6 +8,11 @@ import { $, clearError, duration, showError } from "./dom.js";
 const POLL_MS = 5000;
 let timer = null;
 let running = false;
+let lastStatus = null; // the newest /api/admin/status answer
+// How many live runs the Runs section lists now (null: it is not polling). The header counts
+// these when it can: the server's count comes every 5 s and may lag the list (it once said
+// "0 active runs" beside a running run).
+let listedRuns = null;
 
 function card(title, value, ...lines) {
   return h(
@@ -99,8 +104,24 @@ function render(s) {
   ];
   $("#status-cards").replaceChildren(...cards.filter(Boolean));
   $("#status-updated").textContent = `Updated ${new Date().toLocaleTimeString()}; every ${POLL_MS / 1000} s.`;
+  lastStatus = s;
+  renderSummary();
+}
+
+/** The header line: the live runs (as listed, else as the server counts them), load, memory. */
+function renderSummary() {
+  const s = lastStatus || {};
+  const machine = s.machine || {};
+  const active = listedRuns ?? s.runs?.active_runs;
   const loadNow = machine.load_average ? machine.load_average[0].toFixed(1) : "?";
-  $("#status-summary").textContent = `${runs.active_runs ?? 0} active run${runs.active_runs === 1 ? "" : "s"} · load ${loadNow}/${machine.cpus ?? "?"} · mem ${machine.memory_used_percent ?? "?"} %`;
+  const runsText = active == null ? "? active runs" : `${active} active run${active === 1 ? "" : "s"}`;
+  $("#status-summary").textContent = `${runsText} · load ${loadNow}/${machine.cpus ?? "?"} · mem ${machine.memory_used_percent ?? "?"} %`;
+}
+
+/** The Runs section listed `count` live runs (null: it stopped polling); the header follows. */
+export function setListedRuns(count) {
+  listedRuns = count;
+  renderSummary();
 }
 
 async function poll() {
