@@ -47,6 +47,7 @@ def test_headless_run_prints_a_json_summary_last(tmp_path):
     assert (out / "csv" / "Distance.csv").is_file()
 
 
+@pytest.mark.slow
 def test_failed_run_exits_non_zero_with_the_reason(tmp_path):
     crash = tmp_path / "crash.py"
     crash.write_text("def step(obs):\n    return {}['nothing']\n")
@@ -64,11 +65,17 @@ def test_failed_run_exits_non_zero_with_the_reason(tmp_path):
     ("args", "message"),
     [
         (["--robot", "crowbotz"], "unknown robot 'crowbotz'; valid robot ids: crop_rover"),
-        (["--world", "moon"], "unknown world 'moon'; valid world ids: crop_rows"),
-        (["--world", "crop_rows"], "robot 'crowbot' cannot be placed in world 'crop_rows'"),
-        (["--node", "missing.py"], "node file 'missing.py' does not exist"),
-        (["--duration", "-3"], "a duration must be positive"),
-        (["--duration", "soon"], "'soon' is not a number of seconds"),
+        # Each case starts the CLI (seconds): the fast set (-m "not slow") keeps the first.
+        *(
+            pytest.param(*case, marks=pytest.mark.slow)
+            for case in (
+                (["--world", "moon"], "unknown world 'moon'; valid world ids: crop_rows"),
+                (["--world", "crop_rows"], "robot 'crowbot' cannot be placed in world 'crop_rows'"),
+                (["--node", "missing.py"], "node file 'missing.py' does not exist"),
+                (["--duration", "-3"], "a duration must be positive"),
+                (["--duration", "soon"], "'soon' is not a number of seconds"),
+            )
+        ),
     ],
 )
 def test_newcomer_mistakes_get_a_sentence_not_a_traceback(args, message):

@@ -88,6 +88,7 @@ def data_column(rows: list[dict[str, str]]) -> list[str]:
     return [row[column] for row in rows]
 
 
+@pytest.mark.slow
 def test_a_launch_file_runs_two_nodes_with_a_private_param_and_a_data_file(tmp_path) -> None:
     launch = write_package(tmp_path / "chat", remap=False)
     out = tmp_path / "run"
@@ -101,6 +102,7 @@ def test_a_launch_file_runs_two_nodes_with_a_private_param_and_a_data_file(tmp_p
     assert 10 <= len(said) <= 16  # 5 Hz from the launch file's rate_hz for 3 s
 
 
+@pytest.mark.slow
 def test_a_launch_file_remap_carries_the_talk_to_the_listener(tmp_path) -> None:
     launch = write_package(tmp_path / "chat", remap=True)
     out = tmp_path / "run"
@@ -111,6 +113,7 @@ def test_a_launch_file_remap_carries_the_talk_to_the_listener(tmp_path) -> None:
     assert data_column(topic_rows(out, "conversation"))
 
 
+@pytest.mark.slow
 def test_rosrun_style_flags_reach_the_node(tmp_path) -> None:
     node = tmp_path / "probe.py"
     node.write_text(

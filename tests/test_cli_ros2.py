@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import json
 
+import pytest
+
 from tests.test_cli import robodojo
 
 RCLPY_DRIVER = """\
@@ -37,6 +39,7 @@ rospy.spin()
 """
 
 
+@pytest.mark.slow
 def test_a_rclpy_node_makes_a_ros2_run_with_no_flag(tmp_path):
     node = tmp_path / "approach.py"
     node.write_text(RCLPY_DRIVER)

@@ -20,6 +20,8 @@ import pytest
 import server
 from server.api import app as api_app
 
+pytestmark = pytest.mark.slow  # builds the wheel and installs it
+
 ROOT = Path(__file__).resolve().parent.parent
 # What web/ must ship: the two pages and the bundles they load (not src/ or node tooling).
 WEB_FILES = ("index.html", "admin.html", "static/student.js", "static/student.css",

@@ -182,7 +182,10 @@ def stop_server(server: LabServer, timeout_s: float = 30.0) -> int:
             server.process.stdout.close()
 
 
-@pytest.fixture(scope="session", params=["sqlite", "postgresql"])
+# The PostgreSQL twin of every API test is slow in sum (-m "not slow" runs SQLite only).
+@pytest.fixture(
+    scope="session", params=["sqlite", pytest.param("postgresql", marks=pytest.mark.slow)]
+)
 def lab(request, tmp_path_factory) -> Iterator[LabServer]:
     """The server on its embedded SQLite, then on a fresh PostgreSQL database: every API test
     runs against both (the PostgreSQL half is skipped, saying why, when none is reachable)."""

@@ -147,6 +147,7 @@ def test_resume_of_a_running_run_and_pause_of_a_paused_one_answer_409(lab):
     wait_for_end(student, run_id)
 
 
+@pytest.mark.slow
 def test_behind_a_proxy_the_public_url_is_the_labs_origin_too(tmp_path):
     from tests.api.conftest import start_server, stop_server
 

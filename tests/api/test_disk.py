@@ -14,6 +14,9 @@ import pytest
 
 from tests.api.conftest import STEP_CONTROLLER, LabServer, start_server, stop_server, wait_for_end
 
+# Its own server, and one graded run the later tests build on: the module is one slow story.
+pytestmark = pytest.mark.slow
+
 STUDENT_BUDGET = 1  # [B] any ended run fills it
 LAB_BUDGET = 2  # [B] likewise, for everyone
 

@@ -98,6 +98,7 @@ def send_chunked(server: LabServer, path: str, headers: str = "") -> tuple[bytes
         sock.close()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("path", ["/api/session", "/api/runs"])
 def test_a_chunked_body_over_the_limit_is_refused_as_it_arrives(guarded, path):
     headers = ""
@@ -151,6 +152,7 @@ def test_a_body_under_the_limit_still_arrives_whole(guarded):
     assert answer.status_code in (401, 422), answer.text[:300]
 
 
+@pytest.mark.slow
 def test_headers_that_never_finish_are_closed(guarded):
     sockets = []
     for _ in range(20):

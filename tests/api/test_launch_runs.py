@@ -291,6 +291,7 @@ ROS2_MISTAKES = {
 }
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("mistake", sorted(ROS2_MISTAKES))
 def test_ros2_launch_file_mistakes_are_422_with_the_file_and_line(lab, mistake):
     text, words = ROS2_MISTAKES[mistake]

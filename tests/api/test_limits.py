@@ -49,6 +49,7 @@ def free_run(**changes) -> dict:
     return body
 
 
+@pytest.mark.slow
 def test_runs_at_once_per_student_and_in_total_are_429_with_when_to_retry(small_lab):
     ada, bob, cleo = (small_lab.student(name) for name in ("ada", "bob", "cleo"))
     first = ada.post("/api/runs", json=free_run())
@@ -229,6 +230,7 @@ def test_code_of_the_run_is_kept(lab):
 ODD_VALUES = ["0", "-1", "99999999999999999999999", "1e309", "NaN", "..", "%00", "é", "x" * 300]
 
 
+@pytest.mark.slow
 def test_every_documented_route_survives_odd_parameters(lab):
     """Each route of the OpenAPI document, with each path and query parameter set to odd
     values in turn, as a student and as the instructor: a 4xx at worst, never a 500."""

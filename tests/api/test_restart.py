@@ -10,12 +10,15 @@ import signal
 import time
 
 import psutil
+import pytest
 from mcap.exceptions import EndOfFile
 from mcap.records import Channel, Message
 from mcap.stream_reader import StreamReader
 
 from sandbox.msgs.geometry_msgs import Twist
 from tests.api.conftest import start_server, stop_server, wait_for_end
+
+pytestmark = pytest.mark.slow  # a server started, crashed or stopped per test
 
 SPIN = 'RATE_HZ = 20\n\n\ndef step(obs):\n    print("spin")\n    return {"Control": (0.05, 0.4)}\n'
 

@@ -38,6 +38,8 @@ from tests.api.conftest import (
     wait_for_end,
 )
 
+pytestmark = pytest.mark.slow  # generated requests by the thousand: minutes
+
 MAX_EXAMPLES = 8  # generated requests per operation and role, besides examples and coverage
 ROLES = ("student", "instructor")
 RUN_CAP_S = 3  # [s] of robot time: the longest run a generated request may start

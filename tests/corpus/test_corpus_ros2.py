@@ -311,6 +311,10 @@ CASES = (
 )
 
 
+# The fast set (-m "not slow") runs a quick lockstep sample; each other case takes seconds.
+FAST_CASES = ("params_set", "clean_shutdown_main")
+
+
 def _params():
     # Every lockstep run first, then the realtime ones (which take their duration in wall time).
     for clock in (Clock.LOCKSTEP, Clock.REALTIME):
@@ -319,6 +323,8 @@ def _params():
                 continue
             needs = case.needs + (case.realtime_needs if clock is Clock.REALTIME else ())
             marks = []
+            if clock is Clock.REALTIME or case.id not in FAST_CASES:
+                marks.append(pytest.mark.slow)
             if needs:
                 marks.append(pytest.mark.xfail(reason="needs " + ", ".join(needs), strict=True))
             yield pytest.param(case, clock, id=f"{case.id}-{clock.value}", marks=marks)

@@ -9,6 +9,7 @@ import re
 from pathlib import Path
 
 import httpx
+import pytest
 
 from tests.api.conftest import STEP_CONTROLLER, LabServer, wait_for_end
 
@@ -69,6 +70,7 @@ def _log_in(page, lab: LabServer, token: str) -> None:
     page.goto(f"{lab.url}/admin")
 
 
+@pytest.mark.slow
 def test_instructor_console_in_chromium(web_lab, new_page, screenshots) -> None:
     from playwright.sync_api import expect
 

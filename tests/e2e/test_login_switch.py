@@ -4,7 +4,11 @@ it: Origin and Sec-Fetch-Site) switches the account."""
 
 from __future__ import annotations
 
+import pytest
+
 from tests.api.conftest import LabServer
+
+pytestmark = pytest.mark.slow  # Chromium drives the pages: seconds per test
 
 
 def test_a_login_link_in_a_signed_in_browser_asks_then_switches(

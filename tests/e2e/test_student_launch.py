@@ -7,9 +7,12 @@ from __future__ import annotations
 
 import re
 
+import pytest
 from playwright.sync_api import expect
 
 from tests.e2e.test_student_page import make_student, set_code, shot
+
+pytestmark = pytest.mark.slow  # Chromium drives the pages: seconds per test
 
 TALKER = """\
 import rospy

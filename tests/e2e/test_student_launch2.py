@@ -6,10 +6,13 @@ from __future__ import annotations
 
 import re
 
+import pytest
 from playwright.sync_api import expect
 
 from tests.e2e.test_student_launch import add_data_file, add_node
 from tests.e2e.test_student_page import make_student, shot
+
+pytestmark = pytest.mark.slow  # Chromium drives the pages: seconds per test
 
 TALKER = """\
 import rclpy

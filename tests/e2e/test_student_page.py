@@ -8,7 +8,10 @@ from __future__ import annotations
 import re
 import time
 
+import pytest
 from playwright.sync_api import expect
+
+pytestmark = pytest.mark.slow  # Chromium drives the pages: seconds per test
 
 EXERCISE = "crowbot_distance_pid"
 BROKEN_LINE = 3  # the line of the error the student introduces (1-based)

@@ -20,6 +20,8 @@ from server.exercises.registry import (
 from server.runs.state import RunState
 
 FIVE_SEEDS = (1, 2, 3, 4, 5)
+# The fast set (-m "not slow") grades one quick starter; the rest take seconds each.
+FAST_STARTERS = ("crowbot_data_logger",)
 
 
 @pytest.mark.parametrize("exercise_id", exercise_ids())
@@ -32,6 +34,7 @@ def test_unknown_exercise_lists_the_valid_ids():
         get_exercise("crowbot_distnce_pid")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("exercise_id", exercise_ids())
 def test_reference_passes_on_five_seeds(exercise_id, launcher, tmp_path):
     exercise = dataclasses.replace(get_exercise(exercise_id), seeds=FIVE_SEEDS)
@@ -40,7 +43,10 @@ def test_reference_passes_on_five_seeds(exercise_id, launcher, tmp_path):
     assert result.passed, (failed, [r["reason"] for r in result.runs])
 
 
-@pytest.mark.parametrize("exercise_id", exercise_ids())
+@pytest.mark.parametrize(
+    "exercise_id",
+    [pytest.param(i, marks=() if i in FAST_STARTERS else pytest.mark.slow) for i in exercise_ids()],
+)
 def test_starter_runs_and_fails_a_check(exercise_id, launcher, tmp_path):
     exercise = get_exercise(exercise_id)
     result = grade(exercise, starter_nodes(exercise), launcher, tmp_path)
@@ -48,6 +54,7 @@ def test_starter_runs_and_fails_a_check(exercise_id, launcher, tmp_path):
     assert not all(check.passed for check in result.checks)
 
 
+@pytest.mark.slow
 def test_check_command_grades_and_sets_the_exit_code(tmp_path):
     command = [sys.executable, "-m", "server.cli", "check", "crowbot_distance_pid"]
     passed = subprocess.run([*command, "--reference"], capture_output=True, text=True, timeout=120)

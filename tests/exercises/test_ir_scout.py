@@ -61,6 +61,7 @@ def test_reference_nodes_are_the_papers_four():
     ]
 
 
+@pytest.mark.slow
 def test_reference_topic_graph_is_the_papers_fig_8(reference_run):
     assert reference_run.state is RunState.FINISHED, reference_run.reason
     topics = {topic["name"]: topic for topic in reference_run.graph["topics"]}

@@ -96,6 +96,7 @@ def test_distance_to_polyline():
     assert np.allclose(distances, (0.1, 1.0))
 
 
+@pytest.mark.slow
 def test_pure_pursuit_also_reaches_every_waypoint(launcher, tmp_path):
     exercise = dataclasses.replace(turtlebot.TURTLEBOT_STANLEY, seeds=(1,))
     node = NodeSpec.from_file(EXERCISE_DIR / "reference/turtlebot_pure_pursuit.py", "pursuit")

@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import dataclasses
 
+import pytest
+
 from sandbox.protocol import Clock
 from server.exercises import turtlebot
 from server.exercises.grading import grade, reference_nodes
@@ -20,6 +22,7 @@ def test_graded_exactly_as_the_ros1_exercise():
     assert ros2.params["controller_frequency"] == 5.0  # the thesis's Stanley rate
 
 
+@pytest.mark.slow
 def test_reference_passes_on_the_realtime_clock(launcher, tmp_path):
     exercise = dataclasses.replace(turtlebot.TURTLEBOT_STANLEY_ROS2, seeds=(3,))
     result = grade(exercise, reference_nodes(exercise), launcher, tmp_path, Clock.REALTIME)

@@ -29,6 +29,8 @@ from tests.hardware.crowbot_firmware import CrowBotFirmware
 from tests.hardware.test_serve_hardware import ROSPY
 from tests.waiting import wait_until
 
+pytestmark = pytest.mark.slow  # a server per module; handshake timeouts take seconds
+
 ROBOT = "127.0.0.1"  # the firmware emulator's source address
 STRANGER = "127.0.0.2"
 FLOOD = 20  # idle sockets from one unregistered address: more than max_connections (16)

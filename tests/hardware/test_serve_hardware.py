@@ -16,6 +16,8 @@ from tests.api.conftest import LabServer, start_server, stop_server, wait_for_en
 from tests.hardware.crowbot_firmware import CrowBotFirmware, FirmwareOptions
 from tests.waiting import wait_until
 
+pytestmark = pytest.mark.slow  # a server and an emulated robot per module, runs on the robot
+
 ROSPY = """\
 import rospy
 from std_msgs.msg import Int32

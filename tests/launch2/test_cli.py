@@ -11,6 +11,8 @@ import sys
 from pathlib import Path
 from textwrap import dedent
 
+import pytest
+
 from server.cli import main
 from server.cli_nodes import nodes_from_flags
 
@@ -104,6 +106,7 @@ def write_package(root: Path, launch: str = LAUNCH) -> Path:
     return root / "launch" / "chat.launch.py"
 
 
+@pytest.mark.slow
 def test_a_launch_file_mistake_ends_the_command_with_a_sentence(tmp_path, capsys) -> None:
     launch = write_package(tmp_path / "chat")
     assert main([*BASE, "--launch", str(launch), "greting:=x"]) == 2
@@ -146,6 +149,7 @@ def messages(out: Path, topic: str) -> list[str]:
     return [row[column] for row in rows]
 
 
+@pytest.mark.slow
 def test_two_rclpy_nodes_run_from_a_launch_file(tmp_path) -> None:
     launch = write_package(tmp_path / "chat")
     out = tmp_path / "out"
@@ -162,6 +166,7 @@ def test_two_rclpy_nodes_run_from_a_launch_file(tmp_path) -> None:
     assert echoed and set(echoed) == {"hey robots from speaker"}, echoed[:3]
 
 
+@pytest.mark.slow
 def test_ros_args_set_a_parameter_and_a_remap_of_a_node(tmp_path) -> None:
     node = tmp_path / "talker.py"
     node.write_text(TALKER + '\n\nif __name__ == "__main__":\n    main()\n')

@@ -80,6 +80,7 @@ def test_a_launch_file_cannot_open_a_socket(launcher):
     assert_error(error, 7, r"PermissionError", r"cannot open network connections")
 
 
+@pytest.mark.slow
 def test_a_launch_file_that_never_returns_is_stopped(launcher):
     error = error_of(launcher, launch("    while True:\n        pass\n"))
     assert_error(error, None, rf"longer than {JOB_BUDGET_S:g} s and was stopped", "loop")

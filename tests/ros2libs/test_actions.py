@@ -206,6 +206,7 @@ def feedback_lines(log: str) -> list[str]:
     return re.findall(r"feedback (\[[0-9, ]*\])", log)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("clock", [Clock.LOCKSTEP, Clock.REALTIME])
 def test_the_tutorial_goal_gets_its_feedback_in_order_and_its_result(
     launcher, tmp_path: Path, clock: Clock
@@ -229,6 +230,7 @@ def test_a_cancel_the_server_accepts_ends_the_goal_canceled(launcher, tmp_path: 
     assert len(feedback_lines(client)) <= 3
 
 
+@pytest.mark.slow
 def test_a_sleeping_execute_callback_takes_a_cancel_under_a_multi_threaded_executor(
     launcher, tmp_path: Path
 ) -> None:
@@ -238,6 +240,7 @@ def test_a_sleeping_execute_callback_takes_a_cancel_under_a_multi_threaded_execu
     assert "cancel code=0 canceling=1" in client and "result status=5" in client
 
 
+@pytest.mark.slow
 def test_the_default_cancel_callback_refuses_and_the_goal_finishes(
     launcher, tmp_path: Path
 ) -> None:
@@ -249,12 +252,14 @@ def test_the_default_cancel_callback_refuses_and_the_goal_finishes(
     assert "result status=4 sequence=[0, 1, 1, 2, 3, 5, 8]" in client
 
 
+@pytest.mark.slow
 def test_a_goal_the_server_rejects(launcher, tmp_path: Path) -> None:
     outcome = run_fibonacci(launcher, tmp_path, order=25)
     client = outcome.log("fibonacci_client")
     assert "accepted=False" in client and "result status" not in client, outcome.describe()
 
 
+@pytest.mark.slow
 def test_an_execute_callback_that_sets_no_state_aborts_with_rclpys_warning(
     launcher, tmp_path: Path
 ) -> None:

@@ -10,6 +10,8 @@ import math
 import re
 from pathlib import Path
 
+import pytest
+
 from tests.ros2libs.runs import run_nodes
 
 # The server keeps its executor free while a goal runs (an async execute callback awaiting a
@@ -105,6 +107,7 @@ rclpy.shutdown()
 """
 
 
+@pytest.mark.slow
 def test_a_goal_to_success_and_one_canceled(launcher, tmp_path: Path) -> None:
     outcome = run_nodes(
         launcher, tmp_path, {"fake_nav2": NAV_SERVER, "commander": COMMANDER}, duration_s=6.0
@@ -164,6 +167,7 @@ rclpy.shutdown()
 """
 
 
+@pytest.mark.slow
 def test_waypoints_and_a_path_from_the_runs_navigation(launcher, tmp_path: Path) -> None:
     outcome = run_nodes(
         launcher,

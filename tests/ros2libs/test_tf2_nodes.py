@@ -75,6 +75,7 @@ def recorded_body_poses(outcome) -> dict[int, tuple[float, float, float]]:
     return poses
 
 
+@pytest.mark.slow
 def test_a_listener_sees_the_runs_tree(launcher, tmp_path: Path) -> None:
     outcome = run_nodes(
         launcher,

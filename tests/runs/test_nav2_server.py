@@ -99,6 +99,7 @@ def line(lines, prefix):
     return found[-1].split()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("clock", [Clock.LOCKSTEP, Clock.REALTIME])
 def test_navigate_to_pose_drives_there_with_feedback_and_succeeds(tmp_path, launcher, clock):
     run, result, lines = run_client(tmp_path, launcher, clock, 3.0, 2.2, 0.0, 0)
@@ -137,6 +138,7 @@ def test_an_unreachable_goal_is_aborted_with_a_sentence(tmp_path, launcher):
     assert any("too close to an obstacle" in path.read_text() for path in nav2_log)
 
 
+@pytest.mark.slow
 def test_without_the_controller_service_the_goal_aborts_naming_it(tmp_path, launcher):
     params = {"controller_service": "compute_velocity_commands"}
     _, result, lines = run_client(
@@ -228,6 +230,7 @@ rclpy.spin(node)
 """
 
 
+@pytest.mark.slow
 def test_a_controller_service_slower_than_the_control_period_is_warned_about(tmp_path, launcher):
     spec = RunSpec(
         "turtlebot",

@@ -4,10 +4,14 @@ feedback and status topics, as rclpy.action's ActionClient does underneath."""
 
 from __future__ import annotations
 
+import pytest
+
 from sandbox.protocol import Clock
 from server.runs.run import Run
 from server.runs.spec import NodeSpec, RunSpec
 from server.runs.state import RunState
+
+pytestmark = pytest.mark.slow  # a whole Nav2 action exchange through the sandbox
 
 RAW = """
 import rclpy

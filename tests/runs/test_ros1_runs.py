@@ -82,6 +82,7 @@ rospy.loginfo("reply %s %s", reply.success, reply.message)
 """
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("clock", CLOCKS)
 def test_a_service_between_two_nodes_switches_the_robot(tmp_path, launcher, clock) -> None:
     run = crowbot_run(
@@ -152,6 +153,7 @@ while not rospy.is_shutdown():
 """
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("clock", CLOCKS)
 def test_a_busy_loop_drives_the_robot_and_sees_its_sensor(tmp_path, launcher, clock) -> None:
     result = crowbot_run(
@@ -165,6 +167,7 @@ def test_a_busy_loop_drives_the_robot_and_sees_its_sensor(tmp_path, launcher, cl
     assert 18 <= readings[-1] <= 27, readings[-20:]
 
 
+@pytest.mark.slow
 def test_a_busy_loop_run_is_reproducible(tmp_path, launcher) -> None:
     first = crowbot_run(tmp_path / "a", launcher, node(BUSY_DRIVER, "wall_stop"), duration_s=3.0)
     second = crowbot_run(tmp_path / "b", launcher, node(BUSY_DRIVER, "wall_stop"), duration_s=3.0)
@@ -224,6 +227,7 @@ for name in ("distance", "histogram"):
 """
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("clock", CLOCKS)
 def test_figures_saved_after_signal_shutdown_come_back(tmp_path, launcher, clock) -> None:
     result = crowbot_run(
@@ -270,6 +274,7 @@ rospy.sleep(0.5)
 """
 
 
+@pytest.mark.slow
 def test_a_latched_topic_reaches_a_late_subscriber(tmp_path, launcher) -> None:
     result = crowbot_run(
         tmp_path,

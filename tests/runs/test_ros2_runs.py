@@ -18,6 +18,8 @@ from server.runs.run import Run
 from server.runs.spec import NodeSpec, RunSpec
 from server.runs.state import RunState
 
+pytestmark = pytest.mark.slow  # whole ROS 2 runs on the TurtleBot3 and an exercise: seconds each
+
 STAMPED_DRIVER = """\
 import rclpy
 from rclpy.node import Node

@@ -151,6 +151,7 @@ def test_lockstep_runs_with_one_seed_record_identical_payloads(tmp_path, launche
     assert len(recordings[0]["/Light"]) == 4 * 20 + 1
 
 
+@pytest.mark.slow
 def test_realtime_run_keeps_wall_time(tmp_path, launcher):
     run = crowbot_run(tmp_path, launcher, node(STEP_APPROACH), duration_s=3.0, clock=Clock.REALTIME)
     result = run.execute()
@@ -265,6 +266,7 @@ def test_controls_stop_pause_button_goal_and_faults(tmp_path, launcher):
     assert paused_at + FAULT_S - tolerance_s <= first_after <= paused_at + FAULT_S + SENSOR_PERIOD_S
 
 
+@pytest.mark.slow
 def test_a_failing_run_leaves_a_concurrent_run_alone(tmp_path, launcher):
     good = crowbot_run(tmp_path / "a", launcher, node(STEP_APPROACH), duration_s=30.0)
     results = {}
@@ -370,6 +372,7 @@ rospy.spin()
 }
 
 
+@pytest.mark.slow
 def test_the_papers_four_node_graph_runs_as_four_sandboxes(tmp_path, launcher):
     nodes = tuple(node(code, name) for name, code in PAPER_NODES.items())
     spec = RunSpec(robot="ir_scout", world="obstacle_maze", nodes=nodes, duration_s=2.0)

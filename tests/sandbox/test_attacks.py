@@ -77,6 +77,7 @@ def test_fork_bomb_is_refused(launcher):
     assert exited.error.line == 3
 
 
+@pytest.mark.slow
 def test_memory_bomb_hits_the_address_space_cap(launcher):
     with Bystander(launcher):
         exited = finish(launcher, "hog = []\nwhile True:\n    hog.append(bytearray(50_000_000))\n")
@@ -85,6 +86,7 @@ def test_memory_bomb_hits_the_address_space_cap(launcher):
         assert exited.error.type == "MemoryError"
 
 
+@pytest.mark.slow
 def test_busy_loop_is_killed_at_its_step_budget(launcher):
     with Bystander(launcher):
         started = time.monotonic()
@@ -107,6 +109,7 @@ def test_busy_loop_inside_a_step_is_killed_with_the_time(launcher):
         node.close()
 
 
+@pytest.mark.slow
 def test_sigterm_ignoring_node_is_still_killed(launcher):
     code = "import signal\nsignal.signal(signal.SIGTERM, signal.SIG_IGN)\nwhile True:\n    pass\n"
     exited = finish(launcher, code)
@@ -315,6 +318,7 @@ def test_broken_code_comes_back_readable(launcher, code, error_type, line):
     assert "/opt/robodojo" not in exited.error.traceback
 
 
+@pytest.mark.slow
 def test_touched_memory_is_capped_by_the_cgroup_or_the_rlimit(launcher):
     code = (
         "import numpy as np\nhog = []\nfor _ in range(100):\n    hog.append(np.ones(20_000_000))\n"

@@ -112,6 +112,7 @@ def test_without_bubblewrap_the_launcher_refuses(monkeypatch):
         Launcher(pool_size=0)
 
 
+@pytest.mark.slow
 def test_unsafe_mode_runs_and_says_danger_every_time(caplog):
     launcher = Launcher(pool_size=0, unsafe_no_sandbox=True)
     try:
@@ -180,6 +181,7 @@ def drawing_launcher():
     launcher.close()
 
 
+@pytest.mark.slow
 def test_saving_a_figure_gets_the_end_budget_not_the_step_budget(drawing_launcher):
     launcher = drawing_launcher
     assert launcher.limits.step_budget_s < 1.5 < launcher.limits.shutdown_budget_s
@@ -198,6 +200,7 @@ def test_saving_a_figure_gets_the_end_budget_not_the_step_budget(drawing_launche
         node.close()
 
 
+@pytest.mark.slow
 def test_a_computation_that_is_not_a_figure_still_has_the_step_budget(drawing_launcher):
     code = SLOW_FIGURE_AFTER_THE_LOOP.replace('fig.savefig("slow.png")', "slow()")
     reply, node = run_script(drawing_launcher, code, "spinner")
