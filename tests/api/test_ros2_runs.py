@@ -8,6 +8,8 @@ from __future__ import annotations
 import json
 import time
 
+import pytest
+
 from tests.api.conftest import wait_for_end
 from tests.api.test_live import frames_for, live
 from tests.test_cli_ros2 import RCLPY_DRIVER, ROSPY_TALKER
@@ -52,6 +54,7 @@ def test_a_rclpy_node_runs_as_ros2_and_says_so(lab):
     assert csv.text.splitlines()[0].startswith("time_s,linear.x,linear.y")
 
 
+@pytest.mark.slow
 def test_a_ros2_run_streams_live_telemetry_in_ros2_types(lab):
     student = lab.student("ros2viewer")
     body = {**run_body(("drive", RCLPY_DRIVER)), "clock": "realtime", "duration": 30.0}

@@ -9,6 +9,8 @@ from __future__ import annotations
 import threading
 import time
 
+import pytest
+
 from sandbox.msgs.geometry_msgs import Twist, Vector3
 from server.hardware.rosserial.server import RobotConnection, RosserialHandler, RosserialServer
 from tests.hardware.robot_process import Received, RobotProcess
@@ -69,6 +71,7 @@ def freeze_and_count(freeze_s: float, port_host: str = LOOPBACK) -> tuple[list[R
         return robot_process.received_after(resumed_s), sent_while_frozen
 
 
+@pytest.mark.slow
 def test_a_frozen_robot_gets_the_newest_command_and_the_stop_not_a_backlog() -> None:
     after, sent_while_frozen = freeze_and_count(FREEZE_S)
     assert sent_while_frozen >= FREEZE_S * COMMAND_HZ * 0.8
