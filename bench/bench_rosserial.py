@@ -17,14 +17,26 @@ as plots: at 10 Hz "a consistent sampling time of 0.1 seconds", at 20 Hz "more s
 variations ... the robot starts to encounter difficulties", hence its choice of 10 Hz. The text
 states no latency figures to compare with.
 
+Over emulated WiFi (--wifi, as root where network namespaces can be made): the emulator runs in
+its own network namespace behind a veth pair (2 Mbit tbf) and a relay that adds 20 ms +- 10 ms
+one way and retransmits 2 % of segments 200 ms late (tests/hardware/emulated_wifi.py); the same
+rates are measured over it beside loopback.
+
+--freeze S: the latest-wins check instead: command a robot process at 20 Hz, SIGSTOP it for S
+seconds, send the stop, resume it, and count what it receives (tests/hardware/
+test_rosserial_latest_wins.py).
+
 Usage: python bench/bench_rosserial.py [--duration 5] [--rates 10 20 50 100] [--same-process]
+       [--wifi] [--freeze 10]
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import multiprocessing
 import statistics
+import subprocess
 import sys
 import time
 from pathlib import Path
@@ -35,6 +47,8 @@ from sandbox.msgs import Message
 from sandbox.msgs.geometry_msgs import Twist, Vector3
 from server.hardware.rosserial import RobotConnection, RosserialHandler, RosserialServer
 from tests.hardware.crowbot_firmware import CrowBotFirmware, FirmwareOptions
+from tests.hardware.emulated_wifi import RELAY_PORT, EmulatedWifi, namespaces_unavailable
+from tests.hardware.test_rosserial_latest_wins import freeze_and_count
 
 LOOPBACK = "127.0.0.1"
 
@@ -78,6 +92,23 @@ def percentile(values: list[float], q: float) -> float:
     return ordered[min(len(ordered) - 1, round(q * (len(ordered) - 1)))]
 
 
+def measure_wifi(rate_hz: float, duration_s: float) -> tuple[list[float], int]:
+    """The emulator in its own namespace, through the emulated WiFi link (module docstring)."""
+    with (
+        RosserialServer(Echo(), host="0.0.0.0", port=0) as server,
+        EmulatedWifi().start(server.port) as wifi,
+    ):
+        child = subprocess.run(
+            [*wifi.prefix, sys.executable, str(Path(__file__).resolve()), "--child",
+             "--rates", str(rate_hz), "--duration", str(duration_s)],
+            capture_output=True, text=True, timeout=duration_s + 60, check=False,
+        )  # fmt: skip
+        if child.returncode != 0:
+            raise RuntimeError(f"the emulator in the namespace failed: {child.stderr[-2000:]}")
+        round_trips, sent = json.loads(child.stdout.strip().splitlines()[-1])
+        return round_trips, sent
+
+
 def measure(rate_hz: float, duration_s: float, same_process: bool) -> tuple[list[float], int]:
     with RosserialServer(Echo(), host=LOOPBACK, port=0) as server:
         if same_process:
@@ -96,24 +127,49 @@ def main() -> None:
     parser.add_argument("--duration", type=float, default=5.0, help="[s] measured per rate")
     parser.add_argument("--rates", type=float, nargs="+", default=[10.0, 20.0, 50.0, 100.0])
     parser.add_argument("--same-process", action="store_true", help="emulator in a thread")
+    parser.add_argument("--wifi", action="store_true", help="also over emulated WiFi (root)")
+    parser.add_argument("--freeze", type=float, help="[s] measure a frozen robot's backlog")
+    parser.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
-    where = "the same process" if args.same_process else "a separate process"
-    print(f"Distance -> Control round trip over loopback, emulator in {where}")
-    print(
-        f"{'rate':>6} {'samples':>8} {'answered':>9} {'p50 [ms]':>9} {'p99 [ms]':>9} "
-        f"{'max [ms]':>9} {'+1 loop [ms]':>13}"
-    )
-    for rate_hz in args.rates:
-        round_trips, sent = measure(rate_hz, args.duration, args.same_process)
-        if not round_trips:
-            print(f"{rate_hz:>5.0f}Hz {sent:>8} {'none':>9}")
-            continue
-        ms = [1000 * value for value in round_trips]
+    if args.child:  # inside the namespace: the emulator dials the relay, prints its figures
+        print(json.dumps(run_emulator(RELAY_PORT, args.rates[0], args.duration)))
+        return
+    if args.freeze is not None:
+        after, sent = freeze_and_count(args.freeze)
         print(
-            f"{rate_hz:>5.0f}Hz {sent:>8} {len(ms) / max(sent, 1):>8.1%} "
-            f"{statistics.median(ms):>9.2f} {percentile(ms, 0.99):>9.2f} {max(ms):>9.2f} "
-            f"{1000 / rate_hz:>13.1f}"
+            f"robot frozen {args.freeze:g} s while commanded at 20 Hz: {sent} commands sent "
+            f"meanwhile; after resuming it received {len(after)} Control(s), "
+            f"{sum(r.bytes for r in after)} bytes, the last {after[-1].linear if after else None}"
         )
+        return
+    where = "the same process" if args.same_process else "a separate process"
+    links = ["loopback"]
+    if args.wifi:
+        reason = namespaces_unavailable()
+        if reason is None:
+            links.append("wifi")
+        else:
+            print(f"emulated WiFi skipped: {reason}")
+    print(f"Distance -> Control round trip, emulator in {where} (WiFi: in its namespace)")
+    print(
+        f"{'link':>8} {'rate':>6} {'samples':>8} {'answered':>9} {'p50 [ms]':>9} "
+        f"{'p99 [ms]':>9} {'max [ms]':>9} {'+1 loop [ms]':>13}"
+    )
+    for link in links:
+        for rate_hz in args.rates:
+            if link == "wifi":
+                round_trips, sent = measure_wifi(rate_hz, args.duration)
+            else:
+                round_trips, sent = measure(rate_hz, args.duration, args.same_process)
+            if not round_trips:
+                print(f"{link:>8} {rate_hz:>5.0f}Hz {sent:>8} {'none':>9}")
+                continue
+            ms = [1000 * value for value in round_trips]
+            print(
+                f"{link:>8} {rate_hz:>5.0f}Hz {sent:>8} {len(ms) / max(sent, 1):>8.1%} "
+                f"{statistics.median(ms):>9.2f} {percentile(ms, 0.99):>9.2f} {max(ms):>9.2f} "
+                f"{1000 / rate_hz:>13.1f}"
+            )
     print(
         "'+1 loop' is the extra delay a firmware that reads only once per loop adds at worst.\n"
         "Paper (section 3.5, Figs. 18-19): plots only; 10 Hz steady at 0.1 s, 20 Hz more varied."

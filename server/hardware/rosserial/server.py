@@ -134,6 +134,7 @@ class RobotConnection:
         # Latest-wins outgoing commands (module docstring); rosserial thread only.
         self._held: dict[str, bytes] = {}  # topic -> newest frame not yet written
         self._unanswered: set[str] = set()  # topics written since the robot was last heard
+        self._last_written: dict[str, bytes] = {}  # topic -> the frame written last
 
     @property
     def state(self) -> SessionState:
@@ -196,6 +197,8 @@ class RobotConnection:
             return
         if urgent or self._may_write(topic):
             self._held.pop(topic, None)  # older than this one
+            if urgent and topic in self._unanswered and self._last_written.get(topic) == frame:
+                return  # the same stop again, and the robot has not even read the first
             self._write_command(topic, frame)
             return
         if topic in self._held:
@@ -219,6 +222,7 @@ class RobotConnection:
             return
         self.session.queue_frame(frame)
         self._unanswered.add(topic)
+        self._last_written[topic] = frame
         self._flush()
 
     def _heard(self, now_s: float) -> None:
