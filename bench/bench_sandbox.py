@@ -1,7 +1,8 @@
 """Sandboxed node speed: start time, step round trip, and the Jupyter path as the reference.
 
 Prints median and p99 for
-- cold start: spawn bubblewrap + Python + numpy/matplotlib/scikit-fuzzy until Ready;
+- cold start: spawn bubblewrap + Python + the runner until Ready, and until the first Yield of
+  a step-API controller and of a rospy script (`launcher.start` with an empty pool -> `load`);
 - warm start: take a ready node from the launcher's pool and load a controller;
 - step round trip: parent Wake -> trivial step-API controller -> Yield back (the per-period cost
   of running student code), several thousand times;
@@ -12,8 +13,9 @@ Prints median and p99 for
 jupyter_client and ipykernel are not RoboDojo dependencies; the script installs them with pip
 when missing (or skips the reference with --no-jupyter).
 
-Usage: python bench/bench_sandbox.py [--steps 5000] [--starts 8] [--no-jupyter]
+Usage: python bench/bench_sandbox.py [--steps 5000] [--starts 8] [--no-jupyter] [--starts-only]
 Targets (issue 3): round trip p50 < 50 us and p99 < 300 us, >= 50x faster than Jupyter.
+Targets (issue 18): cold start to the first Yield p50 < 300 ms; warm start p50 ~1 ms.
 """
 
 from __future__ import annotations
@@ -40,6 +42,19 @@ INFO = NodeInfo(
     clock=Clock.LOCKSTEP,
 )
 CONTROLLER = "def step(obs):\n    return (0.1, 0.0)\n"
+ROSPY_CONTROLLER = """import rospy
+from geometry_msgs.msg import Twist
+from std_msgs.msg import Int32
+
+rospy.init_node("bench")
+distance = []
+rospy.Subscriber("Distance", Int32, lambda message: distance.append(message.data))
+publisher = rospy.Publisher("Control", Twist, queue_size=1)
+rate = rospy.Rate(10)
+while not rospy.is_shutdown():
+    publisher.publish(Twist())
+    rate.sleep()
+"""
 DISTANCE_50_CM = b"\x32\x00\x00\x00"  # std_msgs/Int32(50), ROS1 bytes
 
 
@@ -60,8 +75,21 @@ def bench_starts(count: int) -> None:
         node.wait_ready()
         times.append(time.perf_counter() - start)
         node.close()
-    cold.close()
     stats("cold start (spawn until Ready)", times, 1e3, "ms")
+    for label, code, api in (
+        ("step API", CONTROLLER, Api.STEP),
+        ("rospy", ROSPY_CONTROLLER, Api.AUTO),
+    ):
+        times = []
+        for _ in range(count):
+            start = time.perf_counter()
+            node = cold.start("cold")
+            reply = node.load(code, "bench.py", api, INFO)
+            times.append(time.perf_counter() - start)
+            assert isinstance(reply, Yield), reply
+            node.close()
+        stats(f"cold start, {label} (start -> first Yield)", times, 1e3, "ms")
+    cold.close()
 
     warm = Launcher(pool_size=2)
     times = []
@@ -103,10 +131,6 @@ def bench_round_trip(steps: int, cpu: int | None) -> float:
 
 
 def _ignore(message: dict) -> None:
-    """Drop the kernel's output messages (the benchmark measures the round trip only)."""
-
-
-def _ignore(message: dict) -> None:
     """Drop the kernel's output messages: the benchmark measures the round trip only."""
 
 
@@ -144,8 +168,11 @@ def main() -> None:
     parser.add_argument("--steps", type=int, default=5000)
     parser.add_argument("--starts", type=int, default=8)
     parser.add_argument("--no-jupyter", action="store_true")
+    parser.add_argument("--starts-only", action="store_true", help="only the start times")
     args = parser.parse_args()
     bench_starts(args.starts)
+    if args.starts_only:
+        return
     # One run's lockstep loop is sequential (the parent waits while the node computes), so the
     # engine can keep a run and its nodes on one CPU; unpinned shows cross-CPU wake-up cost.
     sandbox_p50 = bench_round_trip(args.steps, cpu=max(os.sched_getaffinity(0)))

@@ -30,6 +30,7 @@ from contextlib import ExitStack
 from typing import ClassVar, Protocol
 
 from sandbox import ros2_imports, ros_imports, runtime
+from sandbox.after_import import AfterImport
 from sandbox.artifacts import collect_artifacts, write_workspace_files
 from sandbox.limits import DEFAULT_LIMITS, Limits
 from sandbox.protocol import Api, Clock, Exited, Load, NodeError, Outcome
@@ -170,20 +171,30 @@ def _install_logging(stack: ExitStack, node: NodeRuntime) -> None:
 def _note_figure_saving(stack: ExitStack, node: NodeRuntime) -> None:
     """Figure.savefig (which plt.savefig calls) tells the parent first: the step that saves a
     figure gets the end budget (sandbox/limits.py), so plotting after a control loop is not cut
-    off by the step budget. matplotlib is imported by the warm pool before any student code."""
-    figure_module = sys.modules.get("matplotlib.figure")
-    if figure_module is None:
-        return
-    figure_class = figure_module.Figure
-    original = figure_class.savefig
+    off by the step budget. A node from the warm pool has matplotlib imported already; a node
+    started cold gets the wrapper when the student's code first imports matplotlib."""
+    patched: list[tuple[type, object]] = []
 
-    def savefig(self: object, *args: object, **kwargs: object) -> object:
-        node.note_drawing()
-        return original(self, *args, **kwargs)
+    def wrap_savefig(figure_module: types.ModuleType) -> None:
+        figure_class = figure_module.Figure
+        original = figure_class.savefig
 
-    savefig.__doc__, savefig.__wrapped__ = original.__doc__, original  # type: ignore[attr-defined]
-    figure_class.savefig = savefig
-    stack.callback(setattr, figure_class, "savefig", original)
+        def savefig(self: object, *args: object, **kwargs: object) -> object:
+            node.note_drawing()
+            return original(self, *args, **kwargs)
+
+        savefig.__doc__, savefig.__wrapped__ = original.__doc__, original  # type: ignore[attr-defined]
+        figure_class.savefig = savefig
+        patched.append((figure_class, original))
+
+    def restore() -> None:
+        for figure_class, original in patched:
+            figure_class.savefig = original  # type: ignore[attr-defined]
+
+    hook = AfterImport("matplotlib.figure", wrap_savefig)
+    hook.install()
+    stack.callback(restore)
+    stack.callback(hook.remove)
 
 
 def _environment(stack: ExitStack, node: NodeRuntime, load: Load, workdir: str) -> None:

@@ -6,6 +6,7 @@ without bubblewrap they fail and say how to install it (scripts/test installs it
 from __future__ import annotations
 
 import dataclasses
+import time
 
 import pytest
 
@@ -50,6 +51,33 @@ def launcher():
     if problem:
         pytest.fail(f"the sandbox tests need bubblewrap: {problem} (./scripts/test installs it)")
     launcher = Launcher(limits=TEST_LIMITS, pool_size=2)
+    yield launcher
+    launcher.close()
+
+
+class WarmOnlyLauncher(Launcher):
+    """Hands out warm nodes only (their heavy libraries imported before the seal), waiting for
+    the pool to refill: the walls must hold for those as for nodes started cold."""
+
+    def start(self, name: str):
+        deadline = time.monotonic() + 60.0
+        while self.warm_count < 1:
+            assert time.monotonic() < deadline, "the warm pool did not refill within 60 s"
+            time.sleep(0.02)
+        return super().start(name)
+
+
+@pytest.fixture(scope="module", params=["warm", "cold"])
+def warm_and_cold_launcher(request):
+    """A launcher whose nodes all come from the warm pool, then one whose nodes all start cold
+    (importing numpy and the rest only when the student's code does)."""
+    problem = bwrap.probe()
+    if problem:
+        pytest.fail(f"the sandbox tests need bubblewrap: {problem} (./scripts/test installs it)")
+    if request.param == "warm":
+        launcher = WarmOnlyLauncher(limits=TEST_LIMITS, pool_size=2)
+    else:
+        launcher = Launcher(limits=TEST_LIMITS, pool_size=0)
     yield launcher
     launcher.close()
 

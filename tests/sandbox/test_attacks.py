@@ -17,6 +17,12 @@ from sandbox.protocol import Exited, Outcome, Yield
 from tests.sandbox.conftest import crowbot_info, run_script
 
 
+@pytest.fixture(scope="module")
+def launcher(warm_and_cold_launcher):
+    """Every attack runs twice: in a node from the warm pool and in one started cold."""
+    return warm_and_cold_launcher
+
+
 def finish(launcher, code: str, name: str = "attack") -> Exited:
     reply, node = run_script(launcher, code, name)
     try:

@@ -4,7 +4,9 @@ artifacts and logs across the wall, budgets, misuse of the API."""
 from __future__ import annotations
 
 import dataclasses
+import json
 import logging
+import time
 
 import pytest
 
@@ -173,10 +175,16 @@ rospy.sleep(0.1)
 """
 
 
-@pytest.fixture(scope="module")
-def drawing_launcher():
-    """Short steps, and an end budget that 1.5 s of CPU fits even on a loaded machine."""
-    launcher = Launcher(limits=dataclasses.replace(TEST_LIMITS, shutdown_budget_s=30.0))
+@pytest.fixture(scope="module", params=["warm", "cold"])
+def drawing_launcher(request):
+    """Short steps, and an end budget that 1.5 s of CPU fits even on a loaded machine. A warm
+    node has matplotlib imported before the student's code; a cold one imports it then."""
+    limits = dataclasses.replace(TEST_LIMITS, shutdown_budget_s=30.0)
+    launcher = Launcher(limits=limits, pool_size=1 if request.param == "warm" else 0)
+    deadline = time.monotonic() + 60.0
+    while request.param == "warm" and launcher.warm_count < 1:
+        assert time.monotonic() < deadline, "the warm pool did not fill within 60 s"
+        time.sleep(0.05)
     yield launcher
     launcher.close()
 
@@ -211,3 +219,49 @@ def test_a_computation_that_is_not_a_figure_still_has_the_step_budget(drawing_la
         assert "exceeded its 1 s step budget" in reply.reason
     finally:
         node.close()
+
+
+COLD_NODE_IMPORTS = """
+import json
+import sys
+
+HEAVY = ["numpy", "scipy", "skfuzzy", "matplotlib", "rclpy"]
+before = sorted(name for name in HEAVY if name in sys.modules)
+import numpy as np
+import scipy.linalg
+import skfuzzy as fuzz
+import matplotlib.pyplot as plt
+
+membership = fuzz.trimf(np.arange(11), [0, 5, 10])
+plt.plot(membership)
+plt.savefig("membership.png")
+with open("imports.json", "w") as f:
+    json.dump({"before": before, "peak": float(membership.max()),
+               "det": float(scipy.linalg.det(np.eye(2)))}, f)
+"""
+
+
+def test_a_cold_node_imports_heavy_libraries_only_when_the_code_does():
+    """A node started with an empty pool is Ready without numpy, matplotlib, scipy, scikit-fuzzy
+    or rclpy; the student's imports load them inside the sealed process, and a saved figure
+    comes back as an artifact."""
+    launcher = Launcher(limits=TEST_LIMITS, pool_size=0)
+    try:
+        reply, node = run_script(launcher, COLD_NODE_IMPORTS, "imports")
+        node.close()
+    finally:
+        launcher.close()
+    assert isinstance(reply, Exited) and reply.outcome is Outcome.FINISHED, reply
+    artifacts = {a.name: a.data for a in reply.artifacts}
+    assert artifacts["membership.png"].startswith(b"\x89PNG")
+    assert json.loads(artifacts["imports.json"]) == {"before": [], "peak": 1.0, "det": 1.0}
+
+
+@pytest.mark.parametrize("call", ["exit()", "quit()", "exit(3)"])
+def test_exit_and_quit_end_a_script_as_in_plain_python(launcher, call):
+    """The runner starts Python without `site` (-S), which would define exit() and quit();
+    the bootstrap gives them back, so a student's script can still call them."""
+    reply, node = run_script(launcher, f"import rospy\nrospy.init_node('quitter')\n{call}\n")
+    node.close()
+    assert isinstance(reply, Exited) and reply.outcome is Outcome.FINISHED, reply
+    assert reply.reason.startswith("sys.exit(")

@@ -1,0 +1,78 @@
+"""Run a function on a module right after it is imported, whenever that happens.
+
+    hook = AfterImport("matplotlib.figure", patch)   # patch(module) now if already imported,
+    hook.install()                                   # else right after the student imports it
+    ...
+    hook.remove()
+
+A node started cold does not import matplotlib ahead (sandbox/runner.py); the node host still
+has to wrap `Figure.savefig` (sandbox/host.py) before the student's first figure is saved. The
+hook is a finder at the front of `sys.meta_path` that lets the other finders find the module
+and wraps the loader they return, so the module loads from the same file as without it.
+"""
+
+from __future__ import annotations
+
+import importlib.abc
+import importlib.machinery
+import sys
+import types
+from collections.abc import Callable, Sequence
+
+Patch = Callable[[types.ModuleType], None]
+
+
+class _PatchingLoader(importlib.abc.Loader):
+    """The real loader, and `patch` once the module's code has run."""
+
+    def __init__(self, inner: importlib.abc.Loader, patch: Patch) -> None:
+        self._inner = inner
+        self._patch = patch
+
+    def create_module(self, spec: importlib.machinery.ModuleSpec) -> types.ModuleType | None:
+        return self._inner.create_module(spec)
+
+    def exec_module(self, module: types.ModuleType) -> None:
+        module.__loader__ = self._inner  # get_source and friends: the real loader's
+        self._inner.exec_module(module)
+        self._patch(module)
+
+    def __getattr__(self, name: str) -> object:
+        return getattr(self._inner, name)
+
+
+class AfterImport(importlib.abc.MetaPathFinder):
+    """Calls `patch(module)` once `name` is imported (at once if it already is)."""
+
+    def __init__(self, name: str, patch: Patch) -> None:
+        self.name = name
+        self._patch = patch
+
+    def install(self) -> None:
+        module = sys.modules.get(self.name)
+        if module is not None:
+            self._patch(module)
+            return
+        sys.meta_path.insert(0, self)
+
+    def remove(self) -> None:
+        if self in sys.meta_path:
+            sys.meta_path.remove(self)
+
+    def find_spec(
+        self,
+        fullname: str,
+        path: Sequence[str] | None,
+        target: types.ModuleType | None = None,
+    ) -> importlib.machinery.ModuleSpec | None:
+        if fullname != self.name:
+            return None
+        self.remove()  # once is enough, and the finders below must not find us again
+        for finder in sys.meta_path:
+            find = getattr(finder, "find_spec", None)
+            spec = find(fullname, path, target) if find is not None else None
+            if spec is not None:
+                if spec.loader is not None:
+                    spec.loader = _PatchingLoader(spec.loader, self._patch)
+                return spec
+        return None
