@@ -26,10 +26,14 @@ function who(userId) {
   return name ? h("span", { title: userId }, name) : h("code", { title: userId }, shortId(userId));
 }
 
+// health.state (server/hardware/health.py): connected / syncing / stale / disconnected.
 function connectionCell(robot) {
   const text = robot.connection || "not connected";
-  const cls = text === "connected" ? "conn-ok" : text.startsWith("connected") ? "conn-warn" : "conn-off";
-  return h("td", { class: "reason" }, h("span", { class: `conn ${cls}` }, text));
+  const state = robot.health ? robot.health.state : "disconnected";
+  const cls = state === "disconnected" ? "conn-off" : text === "connected" ? "conn-ok" : "conn-warn";
+  const ago = robot.health ? robot.health.last_heard_s_ago : null;
+  const title = ago === null || ago === undefined ? "" : `last heard ${ago.toFixed(1)} s ago`;
+  return h("td", { class: "reason" }, h("span", { class: `conn ${cls}`, title }, text));
 }
 
 // ------------------------------------------------------------------------------ robots
