@@ -47,7 +47,10 @@ while not rospy.is_shutdown():
 """
 
 unavailable = namespaces_unavailable()
-pytestmark = pytest.mark.skipif(unavailable is not None, reason=str(unavailable))
+pytestmark = [
+    pytest.mark.skipif(unavailable is not None, reason=str(unavailable)),
+    pytest.mark.slow,  # a server, a namespace and a robot process per module; ~20 s
+]
 
 
 @dataclass
