@@ -119,9 +119,15 @@ def start_server(
 ) -> LabServer:
     port = port or free_port()
     env = dict(os.environ)
-    # Several test servers run at once: each takes any free rosserial port.
+    # Several test servers run at once: each takes any free rosserial port, on loopback only
+    # (the lab's default is every interface, for a bench's WiFi; a test has no robots outside).
     env.update(
-        {"ROBODOJO_SANDBOX_POOL": "2", "PYTHONUNBUFFERED": "1", "ROBODOJO_ROSSERIAL_PORT": "0"}
+        {
+            "ROBODOJO_SANDBOX_POOL": "2",
+            "PYTHONUNBUFFERED": "1",
+            "ROBODOJO_ROSSERIAL_PORT": "0",
+            "ROBODOJO_ROSSERIAL_HOST": "127.0.0.1",
+        }
     )
     env.update(env_extra or {})
     command = [sys.executable, "-m", "server.cli", "serve", "--port", str(port), "--data",
