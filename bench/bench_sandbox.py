@@ -2,7 +2,9 @@
 
 Prints median and p99 for
 - cold start: spawn bubblewrap + Python + the runner until Ready, and until the first Yield of
-  a step-API controller and of a rospy script (`launcher.start` with an empty pool -> `load`);
+  a step-API controller, a rospy script and an rclpy one (`launcher.start` with an empty pool
+  -> `load`), and of a step-API controller that imports numpy, matplotlib and scikit-fuzzy
+  (a cold node imports them when the student's code does);
 - warm start: take a ready node from the launcher's pool and load a controller;
 - step round trip: parent Wake -> trivial step-API controller -> Yield back (the per-period cost
   of running student code), several thousand times;
@@ -41,6 +43,21 @@ INFO = NodeInfo(
     velocity_topic="Control",
     clock=Clock.LOCKSTEP,
 )
+HEAVY_CONTROLLER = (  # the cost a cold node moves into its first step when it uses them all
+    "import matplotlib.pyplot as plt\nimport numpy as np\nimport skfuzzy as fuzz\n\n"
+    "def step(obs):\n    return (0.1, 0.0)\n"
+)
+INFO_ROS2 = NodeInfo(
+    node_name="bench",
+    robot="crowbot",
+    robot_topics=[
+        RobotTopic("Distance", "std_msgs/msg/Int32", "publish", 20.0),
+        RobotTopic("Control", "geometry_msgs/msg/Twist", "subscribe"),
+    ],
+    velocity_topic="Control",
+    clock=Clock.LOCKSTEP,
+    ros_version=2,
+)
 CONTROLLER = "def step(obs):\n    return (0.1, 0.0)\n"
 ROSPY_CONTROLLER = """import rospy
 from geometry_msgs.msg import Twist
@@ -55,6 +72,16 @@ while not rospy.is_shutdown():
     publisher.publish(Twist())
     rate.sleep()
 """
+RCLPY_CONTROLLER = """import rclpy
+from geometry_msgs.msg import Twist
+from rclpy.node import Node
+
+rclpy.init()
+node = Node("bench")
+publisher = node.create_publisher(Twist, "Control", 10)
+node.create_timer(0.1, lambda: publisher.publish(Twist()))
+rclpy.spin(node)
+"""
 DISTANCE_50_CM = b"\x32\x00\x00\x00"  # std_msgs/Int32(50), ROS1 bytes
 
 
@@ -62,7 +89,7 @@ def stats(label: str, seconds: list[float], unit: float = 1e6, name: str = "us")
     ordered = sorted(seconds)
     p50 = statistics.median(ordered) * unit
     p99 = ordered[min(len(ordered) - 1, round(0.99 * (len(ordered) - 1)))] * unit
-    print(f"{label:<44} p50 {p50:10.1f} {name}   p99 {p99:10.1f} {name}   (n={len(ordered)})")
+    print(f"{label:<66} p50 {p50:10.1f} {name}   p99 {p99:10.1f} {name}   (n={len(ordered)})")
     return p50
 
 
@@ -76,15 +103,17 @@ def bench_starts(count: int) -> None:
         times.append(time.perf_counter() - start)
         node.close()
     stats("cold start (spawn until Ready)", times, 1e3, "ms")
-    for label, code, api in (
-        ("step API", CONTROLLER, Api.STEP),
-        ("rospy", ROSPY_CONTROLLER, Api.AUTO),
+    for label, code, api, info in (
+        ("step API", CONTROLLER, Api.STEP, INFO),
+        ("rospy", ROSPY_CONTROLLER, Api.AUTO, INFO),
+        ("rclpy", RCLPY_CONTROLLER, Api.AUTO, INFO_ROS2),
+        ("step API + numpy/mpl/skfuzzy", HEAVY_CONTROLLER, Api.STEP, INFO),
     ):
         times = []
         for _ in range(count):
             start = time.perf_counter()
             node = cold.start("cold")
-            reply = node.load(code, "bench.py", api, INFO)
+            reply = node.load(code, "bench.py", api, info)
             times.append(time.perf_counter() - start)
             assert isinstance(reply, Yield), reply
             node.close()

@@ -13,19 +13,20 @@ and wraps the loader they return, so the module loads from the same file as with
 
 from __future__ import annotations
 
-import importlib.abc
 import importlib.machinery
 import sys
 import types
 from collections.abc import Callable, Sequence
+from typing import Any
 
 Patch = Callable[[types.ModuleType], None]
 
 
-class _PatchingLoader(importlib.abc.Loader):
-    """The real loader, and `patch` once the module's code has run."""
+class _PatchingLoader:
+    """The real loader, and `patch` once the module's code has run. (The import protocol needs
+    the methods, not the importlib.abc base classes, whose import costs a node ~15 ms.)"""
 
-    def __init__(self, inner: importlib.abc.Loader, patch: Patch) -> None:
+    def __init__(self, inner: Any, patch: Patch) -> None:
         self._inner = inner
         self._patch = patch
 
@@ -41,7 +42,7 @@ class _PatchingLoader(importlib.abc.Loader):
         return getattr(self._inner, name)
 
 
-class AfterImport(importlib.abc.MetaPathFinder):
+class AfterImport:
     """Calls `patch(module)` once `name` is imported (at once if it already is)."""
 
     def __init__(self, name: str, patch: Patch) -> None:
