@@ -1,14 +1,20 @@
-"""Run a function on a module right after it is imported, whenever that happens.
+"""Hooks around the student's imports: patch a module once it is imported, or hear that one of
+a few modules is about to be.
 
     hook = AfterImport("matplotlib.figure", patch)   # patch(module) now if already imported,
     hook.install()                                   # else right after the student imports it
     ...
     hook.remove()
 
+    heavy = BeforeImport({"numpy", "matplotlib"}, announce)   # announce() when the student
+    heavy.install()                                           # starts importing one of them
+
 A node started cold does not import matplotlib ahead (sandbox/runner.py); the node host still
-has to wrap `Figure.savefig` (sandbox/host.py) before the student's first figure is saved. The
-hook is a finder at the front of `sys.meta_path` that lets the other finders find the module
-and wraps the loader they return, so the module loads from the same file as without it.
+has to wrap `Figure.savefig` (sandbox/host.py) before the student's first figure is saved, and
+the parent must know that a step is importing a heavy library (it may take longer than a step
+budget). Both hooks are finders at the front of `sys.meta_path`: `AfterImport` lets the other
+finders find the module and wraps the loader they return, so the module loads from the same
+file as without it; `BeforeImport` only listens and finds nothing.
 """
 
 from __future__ import annotations
@@ -77,3 +83,30 @@ class AfterImport:
                     spec.loader = _PatchingLoader(spec.loader, self._patch)
                 return spec
         return None
+
+
+class BeforeImport:
+    """Calls `announce()` when a top-level package in `names` is about to be imported for the
+    first time in this process (a package already in sys.modules is never searched for)."""
+
+    def __init__(self, names: set[str], announce: Callable[[], None]) -> None:
+        self.names = frozenset(names)
+        self._announce = announce
+
+    def install(self) -> None:
+        if self not in sys.meta_path:
+            sys.meta_path.insert(0, self)
+
+    def remove(self) -> None:
+        if self in sys.meta_path:
+            sys.meta_path.remove(self)
+
+    def find_spec(
+        self,
+        fullname: str,
+        path: Sequence[str] | None,
+        target: types.ModuleType | None = None,
+    ) -> None:
+        if fullname in self.names:
+            self._announce()
+        return None  # the other finders find it

@@ -30,7 +30,7 @@ from contextlib import ExitStack
 from typing import ClassVar, Protocol
 
 from sandbox import ros2_imports, ros_imports, runtime
-from sandbox.after_import import AfterImport
+from sandbox.after_import import AfterImport, BeforeImport
 from sandbox.artifacts import collect_artifacts, write_workspace_files
 from sandbox.limits import DEFAULT_LIMITS, Limits
 from sandbox.protocol import Api, Clock, Exited, Load, NodeError, Outcome
@@ -53,8 +53,8 @@ class Link(Protocol):
 def _forget_modules_from(directory: str) -> None:
     """Drop the modules imported from `directory` (the other dialect's layer), so that
     `std_msgs.msg` means this dialect's package and `import rclpy` in a ROS 1 node fails with
-    its sentence: the runner imports rclpy ahead for every node, and one process may run nodes
-    of both dialects in turn (the tests)."""
+    its sentence: the runner imports rclpy ahead for a warm-pool node, and one process may run
+    nodes of both dialects in turn (the tests)."""
     prefix = directory + os.sep
     for name, module in list(sys.modules.items()):
         path = getattr(module, "__file__", None) or ""
@@ -197,6 +197,19 @@ def _note_figure_saving(stack: ExitStack, node: NodeRuntime) -> None:
     stack.callback(hook.remove)
 
 
+# Imported ahead by a warm-pool node; a cold node imports them when the student does, which can
+# take longer than a step budget on a loaded machine (matplotlib.pyplot: 0.3-1.5 s).
+HEAVY_PACKAGES = {"numpy", "scipy", "matplotlib", "skfuzzy", "pandas", "sklearn", "cv2"}
+
+
+def _note_heavy_imports(stack: ExitStack, node: NodeRuntime) -> None:
+    """A step that starts importing a heavy library gets the end budget, as a step saving a
+    figure does: the import is the library's cost, paid once, not the controller's."""
+    hook = BeforeImport(HEAVY_PACKAGES, node.note_drawing)
+    hook.install()
+    stack.callback(hook.remove)
+
+
 def _environment(stack: ExitStack, node: NodeRuntime, load: Load, workdir: str) -> None:
     """Point the interpreter at this node; every change is undone when `stack` closes."""
     install_ros_compat(load.info.ros_version)
@@ -223,6 +236,7 @@ def _environment(stack: ExitStack, node: NodeRuntime, load: Load, workdir: str) 
     warnings.showwarning = _show_warning
     _install_logging(stack, node)
     _note_figure_saving(stack, node)
+    _note_heavy_imports(stack, node)
     lockstep = load.info.clock is Clock.LOCKSTEP
     stack.callback(TimePatch(node.clock, node.sleep_for, node.poll, clocks=lockstep).remove)
     runtime.activate(node)

@@ -239,8 +239,10 @@ class NodeRuntime:
             self.wait_until(self.clock.now_ns())
 
     def note_drawing(self) -> None:
-        """The student's code is saving a figure: tell the parent once per wake, so the step
-        gets the end budget (a 2400x1200 PNG can take longer than a control step may)."""
+        """The student's code is saving a figure (or, in a node started cold, importing a heavy
+        library: sandbox/host.py): tell the parent once per wake, so the step gets the end
+        budget (a 2400x1200 PNG, or `import matplotlib.pyplot` on a loaded machine, can take
+        longer than a control step may)."""
         if self._drawing_noted or threading.get_ident() != self._main_thread:
             return
         self._drawing_noted = True

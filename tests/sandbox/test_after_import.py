@@ -1,4 +1,5 @@
-"""sandbox.after_import: a module gets its patch whether it was imported before or after."""
+"""sandbox.after_import: a module gets its patch whether it was imported before or after; a
+first import of a listed package is announced, and only that."""
 
 from __future__ import annotations
 
@@ -8,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from sandbox.after_import import AfterImport
+from sandbox.after_import import AfterImport, BeforeImport
 
 
 @pytest.fixture
@@ -73,3 +74,23 @@ def test_other_imports_pass_through(package: str) -> None:
         assert afterpkg.__spec__.loader is not None
     finally:
         hook.remove()
+
+
+def test_a_first_import_of_a_listed_package_is_announced_once(package: str) -> None:
+    heard: list[str] = []
+    hook = BeforeImport({"afterpkg"}, lambda: heard.append("import"))
+    hook.install()
+    try:
+        import json  # noqa: F401  # not listed (and imported already)
+
+        assert heard == []
+        import afterpkg.figure  # type: ignore[import-not-found]
+
+        assert heard == ["import"]  # the package, not its submodule
+        assert afterpkg.figure.Figure().save() == "saved"  # found by the other finders
+        import afterpkg  # type: ignore[import-not-found]
+
+        assert heard == ["import"]  # in sys.modules now: no search, no announcement
+    finally:
+        hook.remove()
+    assert hook not in sys.meta_path

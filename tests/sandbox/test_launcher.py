@@ -265,3 +265,30 @@ def test_exit_and_quit_end_a_script_as_in_plain_python(launcher, call):
     node.close()
     assert isinstance(reply, Exited) and reply.outcome is Outcome.FINISHED, reply
     assert reply.reason.startswith("sys.exit(")
+
+
+IMPORT_IN_A_LATER_STEP = """
+def step(obs):
+    if obs.time > 0.15:
+        import matplotlib.pyplot
+        import numpy
+        import skfuzzy  # noqa: F401
+    return (0.1, 0.0)
+"""
+
+
+def test_a_cold_node_importing_heavy_libraries_mid_run_gets_the_end_budget():
+    """A 50 ms step budget is far less than importing matplotlib, numpy and scikit-fuzzy takes;
+    the step that starts the import tells the parent and gets the end budget instead."""
+    limits = dataclasses.replace(TEST_LIMITS, step_budget_s=0.05, shutdown_budget_s=30.0)
+    launcher = Launcher(limits=limits, pool_size=0)
+    node = launcher.start("late")
+    try:
+        reply = node.load(IMPORT_IN_A_LATER_STEP, "late.py", Api.STEP, crowbot_info("late"))
+        for k in range(1, 4):
+            assert isinstance(reply, Yield), reply
+            reply = node.wake(0.1 * k, [])
+        assert isinstance(reply, Yield), reply
+    finally:
+        node.close()
+        launcher.close()
