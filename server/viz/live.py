@@ -33,9 +33,11 @@ async def follow_live(
     view: SceneView,
     telemetry: RunTelemetry,
     lights: Callable[[], tuple[LightSource, ...] | None] = lambda: None,
+    run_state: Callable[[], str | None] = lambda: None,
 ) -> ViewState:
     """Draw the run until its telemetry ends (returns the last state) or the task is cancelled.
-    `lights()`: where the run's lights are now (None: unknown, the last ones drawn stay)."""
+    `lights()`: where the run's lights are now (None: unknown, the last ones drawn stay);
+    `run_state()`: the run's state for the panel ("running", "paused"; None: say "live")."""
     viewer = telemetry.viewer()
     state = ViewState(lights=view.world.lights)
     subscribed: set[str] = set()
@@ -70,17 +72,17 @@ async def follow_live(
                 next_draw_s = now_s + period_s
                 # Viser serializes on its own loop; the calls that queue it still cost ~1 ms a
                 # frame, kept off the web server's loop. This task waits, so state holds still.
-                await asyncio.to_thread(_draw, view, state)
+                await asyncio.to_thread(_draw, view, state, run_state())
         if state.version != drawn_version:  # the last frames came with the end
-            await asyncio.to_thread(_draw, view, state)
+            await asyncio.to_thread(_draw, view, state, run_state())
     finally:
         viewer.close()
     return state
 
 
-def _draw(view: SceneView, state: ViewState) -> None:
+def _draw(view: SceneView, state: ViewState, run_state: str | None) -> None:
     try:
         view.draw(state)
-        view.set_status(f"**live** t = {state.time_s:.2f} s")
+        view.set_status(f"**{run_state or 'live'}** · t = {state.time_s:.2f} s")
     except Exception:  # a frame that cannot be drawn is skipped, the next one tried
         log.exception("live view: a frame failed to draw")

@@ -55,7 +55,16 @@ class LiveRuns(Protocol):
 
     def lights(self, run_id: str) -> tuple[LightSource, ...] | None: ...
 
+    def live(self, run_id: str) -> RunSnapshot | None: ...
+
     def command(self, run_id: str, command: RunCommand) -> bool: ...
+
+
+class RunSnapshot(Protocol):
+    """The part of RunService.live()'s LiveRun the panel shows."""
+
+    @property
+    def state(self) -> object: ...
 
 
 class Mode(StrEnum):
@@ -173,8 +182,14 @@ class VizManager:
     async def _follow(self, session: VizSession, telemetry: RunTelemetry) -> None:
         """Live until the run's telemetry ends, then (recording closed) replay."""
         lights = functools.partial(self.runs.lights, session.run_id)
+        runs, run_id = self.runs, session.run_id
+
+        def run_state() -> str | None:
+            live = runs.live(run_id)
+            return None if live is None else str(live.state)
+
         try:
-            await follow_live(session.view, telemetry, lights)
+            await follow_live(session.view, telemetry, lights, run_state)
         except asyncio.CancelledError:
             raise
         except Exception:

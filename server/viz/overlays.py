@@ -1,5 +1,7 @@
-"""Everything drawn over the world that changes while a run goes: each sensor's reading (cones,
-beams, scan points), the robot's trail, the planned path with its lookahead point, and the goal.
+"""Everything drawn over the world that changes while a run goes: each sensor's reading (cones
+and beams shaded by their reading, scan points coloured by range: near is red, far is teal), the
+robot's trail, the planned path with its lookahead point, and the goal. Each kind hangs below its
+own parent node (/robot/readings, /trail, /route), so a layer toggle hides it whole.
 
 A node is made the first time it has something to show and updated in place after; the trail is
 cut into sealed chunks so a long run sends only its newest chunk each frame, not 20 000 points.
@@ -15,15 +17,28 @@ from server.viz.meshes import transformed, unit_cylinder, yaw_wxyz
 from server.viz.rays import SensorDrawing
 
 SENSOR_NODE = "/robot/readings"  # below the robot: readings are drawn in its frame
-SENSOR_RGB = {"ultrasound": (255, 150, 30), "infrared": (230, 40, 40), "scan": (0, 200, 220)}
-TRAIL_RGB = (90, 60, 200)
-PLAN_RGB = (30, 170, 60)
+TRAIL_NODE, ROUTE_NODE = "/trail", "/route"  # the trail's chunks; the plan, lookahead and goal
+# Range colours, near to far: (fraction of FAR_M, RGB). No blue: that is the robot's colour.
+RANGE_STOPS = (
+    (0.0, (230, 30, 30)),
+    (0.25, (255, 140, 0)),
+    (0.5, (235, 215, 0)),
+    (0.75, (60, 190, 60)),
+    (1.0, (0, 170, 170)),
+)
+SCAN_FAR_M = 4.0  # [m] a scan point this far or further gets the last colour
+# A ranger's cone, shaded by its reading: near is its own colour, at or past FAR_M pale.
+RANGER_NEAR_RGB = {"ultrasound": (240, 100, 0), "infrared": (220, 0, 40)}
+RANGER_FAR_RGB = (250, 220, 150)
+RANGER_FAR_M = 1.5  # [m]
+TRAIL_RGB = (150, 40, 190)
+PLAN_RGB = (20, 160, 60)
 GOAL_RGB = (220, 30, 160)
-LOOKAHEAD_RGB = (255, 220, 0)
-RAY_THICKNESS_M = 0.004  # [m]
-TRAIL_THICKNESS_M = 0.008  # [m]
-PLAN_THICKNESS_M = 0.012  # [m]
-SCAN_POINT_SIZE_M = 0.025  # [m]
+LOOKAHEAD_RGB = (255, 200, 0)
+RAY_THICKNESS_M = 0.008  # [m]
+TRAIL_THICKNESS_M = 0.012  # [m]
+PLAN_THICKNESS_M = 0.016  # [m]
+SCAN_POINT_SIZE_M = 0.03  # [m]
 OVERLAY_LIFT_M = 0.01  # [m] trail, plan and goal float this far above the floor
 TRAIL_CHUNK_POINTS = 64  # [-] points per sealed trail node: the tail resent per frame <= 1.5 KiB
 GOAL_ARROW_M = 0.3  # [m] length of the line showing the goal's yaw
@@ -35,6 +50,25 @@ LOOKAHEAD_M = 0.35  # [m] along the plan, when no node publishes its own `lookah
 def node_name(topic: str) -> str:
     """A topic as one scene-node name segment ("ultrasonic/range_0" -> "ultrasonic_range_0")."""
     return topic.strip("/").replace("/", "_") or "_"
+
+
+def range_colours(distances_m: np.ndarray, far_m: float = SCAN_FAR_M) -> np.ndarray:
+    """(N, 3) uint8 colours of distances [m] along RANGE_STOPS (0 m red ... far_m teal)."""
+    fraction = np.clip(np.asarray(distances_m, dtype=np.float64) / far_m, 0.0, 1.0)
+    stops = np.array([stop for stop, _ in RANGE_STOPS])
+    rgb = np.array([colour for _, colour in RANGE_STOPS], dtype=np.float64)
+    channels = [np.interp(fraction, stops, rgb[:, i]) for i in range(3)]
+    return np.stack(channels, axis=-1).round().astype(np.uint8).reshape(-1, 3)
+
+
+def ranger_colours(segments: np.ndarray, kind: str) -> np.ndarray:
+    """(K, 2, 3) uint8: each segment of a cone shaded by its length (the reading)."""
+    segments = np.asarray(segments, dtype=np.float64).reshape(-1, 4)
+    lengths = np.hypot(segments[:, 2] - segments[:, 0], segments[:, 3] - segments[:, 1])
+    t = np.clip(lengths / RANGER_FAR_M, 0.0, 1.0)[:, None]
+    near = np.array(RANGER_NEAR_RGB.get(kind, RANGER_NEAR_RGB["ultrasound"]), dtype=np.float64)
+    rgb = (1 - t) * near + t * np.array(RANGER_FAR_RGB, dtype=np.float64)
+    return np.repeat(rgb.round().astype(np.uint8)[:, None, :], 2, axis=1)
 
 
 def segments_3d(segments: np.ndarray, z_m: float) -> np.ndarray:
@@ -75,6 +109,10 @@ class Overlays:
     def __init__(self, scene, sensor_height_m: float) -> None:
         self.scene = scene
         self.sensor_height_m = sensor_height_m  # [m] rays are drawn at this height
+        # The parents the layer toggles hide (layers.py).
+        self.readings_root = scene.add_frame(SENSOR_NODE, show_axes=False)
+        self.trail_root = scene.add_frame(TRAIL_NODE, show_axes=False)
+        self.route_root = scene.add_frame(ROUTE_NODE, show_axes=False)
         self.sensor_nodes: dict[str, tuple[object, str]] = {}
         self._trail_sealed: list[object] = []
         self._trail_tail = None
@@ -91,15 +129,16 @@ class Overlays:
         /robot); hide those whose topic is not in `present` (a replay before its first one)."""
         for topic, drawing in drawings.items():
             name = f"{SENSOR_NODE}/{node_name(topic)}"
-            colour = SENSOR_RGB.get(drawing.kind, (200, 200, 200))
             if drawing.kind == "scan":
                 points = np.column_stack(
                     [drawing.points, np.full(len(drawing.points), self.sensor_height_m)]
                 ).astype(np.float32)
-                self._update(topic, name, "points", points, colour)
+                colours = range_colours(np.hypot(drawing.points[:, 0], drawing.points[:, 1]))
+                self._update(topic, name, "points", points, colours)
             else:
                 segments = segments_3d(drawing.segments, self.sensor_height_m)
-                self._update(topic, name, "segments", segments, colour)
+                colours = ranger_colours(drawing.segments, drawing.kind)
+                self._update(topic, name, "segments", segments, colours)
         for topic, (node, _) in self.sensor_nodes.items():
             if topic not in present:
                 node.visible = False
@@ -112,6 +151,7 @@ class Overlays:
             return
         if known is not None:
             known[0].points = data
+            known[0].colors = colour
             known[0].visible = True
             return
         if kind == "points":
@@ -139,7 +179,7 @@ class Overlays:
             index = len(self._trail_sealed)
             self._trail_sealed.append(
                 self.scene.add_line_segments(
-                    f"/trail/{index}",
+                    f"{TRAIL_NODE}/{index}",
                     polyline_segments(chunk, OVERLAY_LIFT_M),
                     TRAIL_RGB,
                     thickness=TRAIL_THICKNESS_M,
@@ -154,7 +194,7 @@ class Overlays:
         segments = polyline_segments(tail, OVERLAY_LIFT_M)
         if self._trail_tail is None:
             self._trail_tail = self.scene.add_line_segments(
-                "/trail/tail", segments, TRAIL_RGB, thickness=TRAIL_THICKNESS_M
+                f"{TRAIL_NODE}/tail", segments, TRAIL_RGB, thickness=TRAIL_THICKNESS_M
             )
         else:
             self._trail_tail.points = segments
@@ -182,7 +222,7 @@ class Overlays:
                 segments = polyline_segments(plan, OVERLAY_LIFT_M)
                 if self._plan_node is None:
                     self._plan_node = self.scene.add_line_segments(
-                        "/plan", segments, PLAN_RGB, thickness=PLAN_THICKNESS_M
+                        f"{ROUTE_NODE}/plan", segments, PLAN_RGB, thickness=PLAN_THICKNESS_M
                     )
                 else:
                     self._plan_node.points = segments
@@ -199,7 +239,7 @@ class Overlays:
         position = (float(point[0]), float(point[1]), OVERLAY_LIFT_M + 0.03)
         if self._lookahead_node is None:
             self._lookahead_node = self.scene.add_icosphere(
-                "/lookahead", radius=0.04, color=LOOKAHEAD_RGB, position=position
+                f"{ROUTE_NODE}/lookahead", radius=0.04, color=LOOKAHEAD_RGB, position=position
             )
         else:
             self._lookahead_node.position = position
@@ -215,16 +255,16 @@ class Overlays:
             return
         x, y, yaw = goal
         if self._goal_node is None:
-            self._goal_node = self.scene.add_frame("/goal", show_axes=False)
+            self._goal_node = self.scene.add_frame(f"{ROUTE_NODE}/goal", show_axes=False)
             vertices, faces = unit_cylinder()
             self.scene.add_mesh_simple(
-                "/goal/disc",
+                f"{ROUTE_NODE}/goal/disc",
                 transformed(vertices, (GOAL_DISC_M, GOAL_DISC_M, 0.01), (0, 0, OVERLAY_LIFT_M)),
                 faces,
                 color=GOAL_RGB,
             )
             self.scene.add_line_segments(
-                "/goal/heading",
+                f"{ROUTE_NODE}/goal/heading",
                 np.array([[[0.0, 0.0, OVERLAY_LIFT_M], [GOAL_ARROW_M, 0.0, OVERLAY_LIFT_M]]]),
                 GOAL_RGB,
                 thickness=PLAN_THICKNESS_M,

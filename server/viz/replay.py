@@ -86,7 +86,9 @@ class ReplayPlayer:
                 continue
             try:
                 self.view.draw(self.recording.state_at(wanted, self.lights))
-                self.view.set_status(f"**replay** t = {wanted:.2f} s of {self.duration_s:.2f} s")
+                self.view.set_status(
+                    f"**replay** · ended · t = {wanted:.2f} s of {self.duration_s:.2f} s"
+                )
             except Exception:  # one bad frame must not end the replay
                 log.exception("replay of %s: frame at %.3f s failed", self.recording.path, wanted)
             self._shown_s = wanted

@@ -20,19 +20,23 @@ from server.viz.meshes import transformed, unit_box, unit_cylinder, yaw_wxyz
 from server.viz.view_state import SensorFrame
 
 ROBOT_NODE = "/robot"
-BODY_RGB = (60, 110, 200)
+# A saturated blue no floor, wall, furniture or overlay uses, dark enough for a 3:1 contrast on
+# the light floor (world_scene.py): the robot is found at a glance, and by the e2e test.
+BODY_RGB = (30, 80, 215)
 NOSE_RGB = (250, 250, 250)
 WHEEL_RGB = (30, 30, 30)
 LED_OFF_RGB = (45, 45, 45)  # an unlit LED is dark plastic, not black paint
 BUZZER_RGB = (255, 200, 0)
-SENSOR_RGB = (220, 60, 60)
+SENSOR_RGB = (235, 120, 20)  # sensor housings: orange on the blue body
+# Frames that hold a sensor worth a housing (not imu_link or base_footprint: inside the body).
+SENSOR_FRAME_PREFIXES = ("ultrasonic", "camera", "laser", "base_scan", "ir")
 WHEEL_WIDTH_FRACTION = 0.6  # [1] of the wheel radius: a plausible tyre width
 LED_RADIUS_FRACTION = 0.07  # [1] of the body radius
 LED_PLACEMENT = ((1, 1), (1, -1), (-1, 1), (-1, -1))  # corners of the top: front/back, left/right
-SENSOR_BLOCK_M = 0.02  # [m] side of the block drawn at a sensor frame
+SENSOR_BLOCK_M = 0.025  # [m] side of the block drawn at a sensor frame
 # TurtleBot3 Burger (URDF base_link collision box 0.140 x 0.140 x 0.143 m; LDS-01 69.5 x 95.5 x
 # 39.5 mm, its URDF cylinder r = 0.055 m, 0.0315 m tall, centre 15 mm ahead of base_scan).
-BURGER_PLATE_RGB = (45, 45, 50)  # the dark grey waffle plates
+BURGER_PLATE_RGB = BODY_RGB  # the waffle plates (dark grey on the robot): the robots' blue
 BURGER_LDS_RGB = (25, 25, 25)
 BURGER_LDS_TOP_RGB = (200, 60, 40)  # the orange-red rotor cap, seen from above
 BURGER_PLATE_SIDES = 8  # [-] octagons: the plates are squares with cut corners
@@ -168,6 +172,13 @@ class RobotDrawing:
             )
         self.sensor_blocks: dict[str, object] = {}
         self._shown: dict[str, object] = {}
+        # The sensors the robot declares a fixed frame for (the TurtleBot's ultrasonic ring and
+        # depth camera, the rover's laser), drawn from the start; a frame /tf moves (the IR
+        # ranger's servo) is drawn and moved by update().
+        for frame, mount in robot.frames.items():
+            if frame.startswith(SENSOR_FRAME_PREFIXES):
+                x, y, heading = mount[0], mount[1], mount[2]
+                self._sensor_block(frame, SensorFrame(x, y, heading, 1.0))
 
     def _changed(self, key: str, value: object) -> bool:
         if self._shown.get(key) == value:
@@ -194,16 +205,19 @@ class RobotDrawing:
                 led.color = colour
         if self.buzzer is not None and self._changed("buzzer", buzzer_on):
             self.buzzer.visible = buzzer_on
-        height = self.robot.geometry.height_m
         for frame, mount in sensor_frames.items():
-            block = self.sensor_blocks.get(frame)
-            if block is None:
-                block = self.scene.add_box(
-                    f"{ROBOT_NODE}/sensors/{frame}",
-                    color=SENSOR_RGB,
-                    dimensions=(SENSOR_BLOCK_M, SENSOR_BLOCK_M, SENSOR_BLOCK_M / 2),
-                )
-                self.sensor_blocks[frame] = block
-            if self._changed(f"frame:{frame}", mount):
-                block.position = (mount.x, mount.y, height + SENSOR_BLOCK_M / 4)
-                block.wxyz = yaw_wxyz(mount.heading)
+            self._sensor_block(frame, mount)
+
+    def _sensor_block(self, frame: str, mount: SensorFrame) -> None:
+        """A sensor's housing at its frame, on the body's rim (inside it, it would not show)."""
+        block = self.sensor_blocks.get(frame)
+        if block is None:
+            block = self.scene.add_box(
+                f"{ROBOT_NODE}/sensors/{frame}",
+                color=SENSOR_RGB,
+                dimensions=(SENSOR_BLOCK_M, SENSOR_BLOCK_M, SENSOR_BLOCK_M / 2),
+            )
+            self.sensor_blocks[frame] = block
+        if self._changed(f"frame:{frame}", mount):
+            block.position = (mount.x, mount.y, self.robot.geometry.height_m + SENSOR_BLOCK_M / 4)
+            block.wxyz = yaw_wxyz(mount.heading)

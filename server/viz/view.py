@@ -1,5 +1,10 @@
 """One run's 3D view on one ViserServer: the world, the robot, the overlays and the lights put
-together, `draw(state)` to show a `ViewState`, and the run's controls wired to the scene (a click
+together under a lighting that shades them and that software WebGL draws at a few frames a
+second (viser's default lights without shadows and an ambient light, no environment map: with
+it Chromium's SwiftShader took 12-20 s a frame at 1400x850 and showed a washed-out, near-white
+scene meanwhile), the panel (the run's state and time,
+the camera folder of camera.py, the layer toggles of layers.py), `draw(state)` to show a
+`ViewState`, and the run's controls wired to the scene (a click
 on the floor of a mapped world sends a `Goal`; dragging a movable light sends a `Light`: typed
 commands, server/runs/commands.py, handed to `send`, which the manager binds to
 `RunService.command` for this run).
@@ -14,9 +19,13 @@ import logging
 import math
 from collections.abc import Callable
 
+import numpy as np
+
 from server.runs.commands import Goal, Light, RunCommand
 from server.sim.registry import get_robot
 from server.sim.world import load_world
+from server.viz.camera import CameraControls
+from server.viz.layers import Layer, LayerToggles
 from server.viz.lights import LightMarkers
 from server.viz.overlays import Overlays
 from server.viz.rays import reading_key, sensor_drawings
@@ -26,8 +35,8 @@ from server.viz.world_scene import draw_world
 
 log = logging.getLogger("robodojo.viz")
 SENSOR_HEIGHT_FRACTION = 0.6  # [1] of the robot's height: where rays and scan points are drawn
-CAMERA_BACK = 0.15  # [1] of the world's larger side: the first camera stands this far south
-CAMERA_UP = 1.2  # [1] of the world's larger side, this high: looking down over the walls
+AMBIENT_INTENSITY = 1.2  # [1] fills the faces the default lights miss (else they go black)
+BACKGROUND_RGB = (206, 212, 222)  # a pale blue-grey sky: the floor's edge reads against it
 
 
 # Sends a command to the run on show: False (or an error) when the run has ended.
@@ -57,27 +66,51 @@ class SceneView:
         self.send = send  # None: a replay, or a run that has ended
         scene = server.scene
         scene.set_up_direction("+z")
-        min_x, min_y, max_x, max_y = self.world.bounds
-        span = max(max_x - min_x, max_y - min_y)
-        centre = ((min_x + max_x) / 2, (min_y + max_y) / 2)
-        server.initial_camera.position = (centre[0], min_y - CAMERA_BACK * span, CAMERA_UP * span)
-        server.initial_camera.look_at = (centre[0], centre[1], 0.0)
+        scene.configure_environment_map(hdri=None)
+        scene.configure_default_lights(enabled=True, cast_shadow=False)
+        scene.add_light_ambient("/ambient", intensity=AMBIENT_INTENSITY)
+        scene.set_background_image(np.full((2, 2, 3), BACKGROUND_RGB, dtype=np.uint8))
+        self.status = server.gui.add_markdown("")
         self.world_nodes = draw_world(scene, self.world)
         self.robot_drawing = RobotDrawing(scene, self.robot)
         spawn = self.world.spawns[0]
-        self.robot_drawing.update((spawn.x, spawn.y, spawn.yaw), None, False, {})
-        self.overlays = Overlays(scene, SENSOR_HEIGHT_FRACTION * self.robot.geometry.height_m)
+        start = (spawn.x, spawn.y, spawn.yaw)
+        self.robot_drawing.update(start, None, False, {})
+        g = self.robot.geometry
+        self.camera = CameraControls(
+            server, start, max(g.length_m, g.width_m, g.height_m), g.height_m, self.world.bounds
+        )
+        self.overlays = Overlays(scene, SENSOR_HEIGHT_FRACTION * g.height_m)
         self.lights = LightMarkers(
             scene,
             self.world.lights,
             self.world.bounds,
             on_move=self._move_light if send is not None else None,
         )
+        self.layers = LayerToggles(server.gui, self._layers())
         self.pose: tuple[float, float, float] | None = None
         self._reading_keys: dict[str, tuple] = {}  # topic -> reading_key last drawn
         if send is not None and self.world.grid_map is not None:
             scene.on_click()(self._clicked)
-        self.status = server.gui.add_markdown("")
+
+    def _layers(self) -> list[Layer]:
+        node = self.server.scene.get_handle_by_name
+        world = [
+            node(name)
+            for name in self.world_nodes.names
+            if name not in ("/world/floor", "/world/grid", "/world/map")
+            and not name.startswith("/world/tape_")
+        ]
+        overlays = self.overlays
+        return [
+            Layer("Walls and furniture", tuple(world)),
+            Layer("Floor grid", (node("/world/grid"),)),
+            Layer("Map", (node("/world/map"),) if self.world_nodes.has_map else ()),
+            Layer("Sensor readings", (overlays.readings_root,)),
+            Layer("Trail", (overlays.trail_root,)),
+            Layer("Plan and goal", (overlays.route_root,)),
+            Layer("Lights", tuple(self.lights.nodes.values())),
+        ]
 
     # ----------------------------------------------------------------------------- drawing
     def draw(self, state: ViewState) -> None:
@@ -101,8 +134,11 @@ class SceneView:
             if state.lights:
                 self.lights.update(state.lights)
         self.pose = state.pose
+        if state.pose is not None:
+            self.camera.follow(state.pose)
 
     def set_status(self, text: str) -> None:
+        """The panel's first line: the run's state and time (live.py, replay.py, manager.py)."""
         self.status.content = text
 
     # ----------------------------------------------------------------------------- controls

@@ -17,18 +17,23 @@ import numpy as np
 from server.sim.world import MAP_OCCUPIED, MAP_UNKNOWN, GridMap, World
 from server.viz.meshes import unit_box, unit_cylinder, yaw_wxyz, yaw_wxyzs
 
-WALL_THICKNESS_M = 0.02  # [m] walls are lines to the simulator; drawn this thick to be seen
-WALL_OPACITY = 0.45  # [1] see-through: a 2 m office wall would hide the robot behind it
+WALL_THICKNESS_M = 0.03  # [m] walls are lines to the simulator; drawn this thick to be seen
+WALL_OPACITY = 0.5  # [1] see-through: a 2 m office wall would hide the robot behind it
 FLOOR_MARGIN_M = 0.3  # [m] floor beyond the world's bounds, so the edge walls stand on it
 FLOOR_THICKNESS_M = 0.01  # [m] top face at z = 0
 MAP_LIFT_M = 0.002  # [m] above the floor, so the map does not flicker against it
 TAPE_LIFT_M = 0.003  # [m] above the map
-# Colours, RGB 0-255.
-FLOOR_RGB = (214, 210, 200)
-WALL_RGB = (150, 156, 170)
-BOX_RGB = (176, 128, 82)
-PLANT_RGB = (64, 150, 64)
-POST_RGB = (120, 120, 128)
+GRID_LIFT_M = 0.001  # [m] above the floor, below the map
+GRID_CELLS_PER_SECTION = 5  # [-] a darker line every 5 cells
+# Colours, RGB 0-255: a light floor with a darker grid, so dark tape and the map read on it and
+# the robot (robot_drawing.py: saturated blue) stands out; walls a darker slate with shading.
+FLOOR_RGB = (226, 224, 216)
+GRID_CELL_RGB = (192, 190, 182)
+GRID_SECTION_RGB = (150, 148, 140)
+WALL_RGB = (104, 114, 132)
+BOX_RGB = (168, 116, 70)
+PLANT_RGB = (50, 140, 60)
+POST_RGB = (110, 110, 118)
 MAP_OCCUPIED_RGBA = (40, 40, 60, 150)
 MAP_UNKNOWN_RGBA = (90, 90, 90, 70)
 
@@ -104,6 +109,13 @@ def tape_mesh(world: World) -> dict[int, tuple[np.ndarray, np.ndarray]]:
     }
 
 
+def grid_cell_m(bounds: tuple[float, float, float, float]) -> float:
+    """The floor grid's cell [m]: 0.1 m in a table-top arena, 0.5 m in a room (~20-40 cells
+    across the world's larger side either way)."""
+    min_x, min_y, max_x, max_y = bounds
+    return 0.1 if max(max_x - min_x, max_y - min_y) <= 4.0 else 0.5
+
+
 def map_image(grid: GridMap) -> np.ndarray:
     """The occupancy grid as an RGBA image (height, width, 4): free cells clear, occupied dark,
     unknown grey. Rows stay in the grid's order (row 0 at the map's origin, smallest y): viser
@@ -147,6 +159,7 @@ def _draw_slabs(
 
 def draw_world(scene, world: World) -> WorldNodes:
     """Add `world` under /world in `scene` (a viser SceneApi); returns what was drawn."""
+    scene.add_frame("/world", show_axes=False)
     names = []
     min_x, min_y, max_x, max_y = world.bounds
     size_x, size_y = max_x - min_x + 2 * FLOOR_MARGIN_M, max_y - min_y + 2 * FLOOR_MARGIN_M
@@ -158,6 +171,21 @@ def draw_world(scene, world: World) -> WorldNodes:
         cast_shadow=False,
     )
     names.append("/world/floor")
+    cell_m = grid_cell_m(world.bounds)
+    scene.add_grid(
+        "/world/grid",
+        width=max_x - min_x,
+        height=max_y - min_y,
+        plane="xy",
+        cell_size=cell_m,
+        cell_color=GRID_CELL_RGB,
+        section_size=GRID_CELLS_PER_SECTION * cell_m,
+        section_color=GRID_SECTION_RGB,
+        section_thickness=1.5,
+        shadow_opacity=0.2,
+        position=((min_x + max_x) / 2, (min_y + max_y) / 2, GRID_LIFT_M),
+    )
+    names.append("/world/grid")
     walls, boxes = wall_slabs(world), box_slabs(world)
     for name, slabs, rgb, opacity in (
         ("/world/walls", walls, WALL_RGB, WALL_OPACITY),

@@ -58,6 +58,10 @@ class FakeService:
         active = self.running.get(run_id)
         return active.run.sim.lights if active is not None and active.run.sim else None
 
+    def live(self, run_id: str):
+        active = self.running.get(run_id)
+        return SimpleNamespace(state=active.run.state) if active is not None else None
+
     def command(self, run_id: str, command: RunCommand) -> bool:
         self.sent.append((run_id, command))
         return run_id in self.running

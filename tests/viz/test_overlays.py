@@ -61,10 +61,22 @@ def test_sensors_path_and_goal(viser_server):
     assert scene.get_handle_by_name("/robot/readings/scan").visible
     plan = [(0.0, 0.0), (1.0, 0.0)]
     overlays.draw_path(plan, (0.0, 0.0, 0.0), None)
-    assert scene.get_handle_by_name("/plan").points.shape == (1, 2, 3)
-    assert tuple(scene.get_handle_by_name("/lookahead").position[:2]) == pytest.approx((0.35, 0))
+    assert scene.get_handle_by_name("/route/plan").points.shape == (1, 2, 3)
+    lookahead = scene.get_handle_by_name("/route/lookahead")
+    assert tuple(lookahead.position[:2]) == pytest.approx((0.35, 0))
     overlays.draw_path(plan, (0.0, 0.0, 0.0), (0.7, 0.1))  # a node's own lookahead wins
-    assert tuple(scene.get_handle_by_name("/lookahead").position[:2]) == pytest.approx((0.7, 0.1))
+    assert tuple(lookahead.position[:2]) == pytest.approx((0.7, 0.1))
     overlays.draw_goal((2.0, 3.0, 0.5))
-    goal = scene.get_handle_by_name("/goal")
+    goal = scene.get_handle_by_name("/route/goal")
     assert tuple(goal.position) == pytest.approx((2.0, 3.0, 0.0)) and goal.visible
+
+
+def test_scan_points_are_coloured_by_range_and_cones_by_reading() -> None:
+    from server.viz.overlays import RANGE_STOPS, range_colours, ranger_colours
+
+    colours = range_colours(np.array([0.0, 2.0, 100.0]))
+    assert tuple(colours[0]) == RANGE_STOPS[0][1] and tuple(colours[2]) == RANGE_STOPS[-1][1]
+    assert tuple(colours[1]) == RANGE_STOPS[2][1]  # half of SCAN_FAR_M
+    near = ranger_colours(np.array([[0, 0, 0.1, 0]]), "ultrasound")
+    far = ranger_colours(np.array([[0, 0, 3.0, 0]]), "ultrasound")
+    assert near.shape == (1, 2, 3) and near[0, 0].sum() < far[0, 0].sum()  # far is paler
