@@ -33,7 +33,9 @@ SENSOR_FRAME_PREFIXES = ("ultrasonic", "camera", "laser", "base_scan", "ir")
 WHEEL_WIDTH_FRACTION = 0.6  # [1] of the wheel radius: a plausible tyre width
 LED_RADIUS_FRACTION = 0.07  # [1] of the body radius
 LED_PLACEMENT = ((1, 1), (1, -1), (-1, 1), (-1, -1))  # corners of the top: front/back, left/right
-SENSOR_BLOCK_M = 0.025  # [m] side of the block drawn at a sensor frame
+SENSOR_BLOCK_M = 0.025  # [m] side of the block drawn at a sensor frame...
+SENSOR_BLOCK_FRACTION = 0.2  # [1] ...or this much of the body radius, if smaller (the CrowBot's
+# five front sensors would merge into one blob over its nose)
 # TurtleBot3 Burger (URDF base_link collision box 0.140 x 0.140 x 0.143 m; LDS-01 69.5 x 95.5 x
 # 39.5 mm, its URDF cylinder r = 0.055 m, 0.0315 m tall, centre 15 mm ahead of base_scan).
 BURGER_PLATE_RGB = BODY_RGB  # the waffle plates (dark grey on the robot): the robots' blue
@@ -179,6 +181,16 @@ class RobotDrawing:
             if frame.startswith(SENSOR_FRAME_PREFIXES):
                 x, y, heading = mount[0], mount[1], mount[2]
                 self._sensor_block(frame, SensorFrame(x, y, heading, 1.0))
+        # Sensors mounted without a frame of their own (the CrowBot's ultrasonic ranger and its
+        # light and line sensors): a housing at each mount.
+        for topic, sensor in robot.build_sensors().items():
+            mounts = getattr(sensor, "mounts", None) or (
+                (sensor.mount,) if hasattr(sensor, "mount") else ()
+            )
+            for index, mount in enumerate(mounts):
+                self._sensor_block(
+                    f"{topic}_{index}", SensorFrame(mount.x_m, mount.y_m, mount.yaw_rad, 1.0)
+                )
 
     def _changed(self, key: str, value: object) -> bool:
         if self._shown.get(key) == value:
@@ -210,14 +222,15 @@ class RobotDrawing:
 
     def _sensor_block(self, frame: str, mount: SensorFrame) -> None:
         """A sensor's housing at its frame, on the body's rim (inside it, it would not show)."""
+        side_m = min(SENSOR_BLOCK_M, SENSOR_BLOCK_FRACTION * self.robot.geometry.body_radius_m)
         block = self.sensor_blocks.get(frame)
         if block is None:
             block = self.scene.add_box(
                 f"{ROBOT_NODE}/sensors/{frame}",
                 color=SENSOR_RGB,
-                dimensions=(SENSOR_BLOCK_M, SENSOR_BLOCK_M, SENSOR_BLOCK_M / 2),
+                dimensions=(side_m, side_m, side_m / 2),
             )
             self.sensor_blocks[frame] = block
         if self._changed(f"frame:{frame}", mount):
-            block.position = (mount.x, mount.y, self.robot.geometry.height_m + SENSOR_BLOCK_M / 4)
+            block.position = (mount.x, mount.y, self.robot.geometry.height_m + side_m / 4)
             block.wxyz = yaw_wxyz(mount.heading)

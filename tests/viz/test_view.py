@@ -65,6 +65,14 @@ def test_the_robot_follows_the_state(viser_server):
     assert scene.get_handle_by_name("/robot/led_0") is None  # the IR scout has no LEDs
 
 
+def test_the_turtlebots_ring_and_depth_camera_are_drawn_from_the_start(viser_server):
+    SceneView(viser_server, "turtlebot", "office")
+    scene = viser_server.scene
+    for frame in ("camera_depth_frame", *(f"ultrasonic_{i}" for i in range(7))):
+        assert scene.get_handle_by_name(f"/robot/sensors/{frame}") is not None, frame
+    assert scene.get_handle_by_name("/robot/sensors/imu_link") is None  # inside the body
+
+
 def test_crowbot_leds_and_buzzer(viser_server):
     view = SceneView(viser_server, "crowbot", "light_arena")
     state = ViewState(pose=(1.0, 1.0, 0.0), leds_rgb=(0, 255, 0), buzzer_until_s=2.0)
@@ -74,6 +82,10 @@ def test_crowbot_leds_and_buzzer(viser_server):
     assert all(
         tuple(scene.get_handle_by_name(f"/robot/led_{i}").color) == (0, 255, 0) for i in range(4)
     )
+    # Its sensors are drawn from the start: the ultrasonic ranger and the two light sensors.
+    ranger = scene.get_handle_by_name("/robot/sensors/Distance_0")
+    assert tuple(ranger.position[:2]) == pytest.approx((0.05, 0.0))
+    assert scene.get_handle_by_name("/robot/sensors/Light_1") is not None
     assert scene.get_handle_by_name("/robot/buzzer").visible
     state.time_s = 2.5
     view.draw(state)
