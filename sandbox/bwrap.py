@@ -227,8 +227,11 @@ def precompile_package() -> bool:
     directory is not writable (an installed package normally comes compiled)."""
     import compileall
 
+    package = sandbox_package_dir()
+    if not os.access(package, os.W_OK):
+        return False  # nothing could be written: do not compile it all in vain at every start
     try:
-        return bool(compileall.compile_dir(sandbox_package_dir(), quiet=2))
+        return bool(compileall.compile_dir(package, quiet=2))
     except OSError:
         return False
 

@@ -292,3 +292,17 @@ def test_a_cold_node_importing_heavy_libraries_mid_run_gets_the_end_budget():
     finally:
         node.close()
         launcher.close()
+
+
+def test_the_sandbox_package_is_compiled_before_nodes_read_it(tmp_path, monkeypatch):
+    """Nodes see the package read-only and write no bytecode: the launcher writes it first."""
+    from sandbox import bwrap
+
+    package = tmp_path / "sandbox"
+    (package / "msgs").mkdir(parents=True)
+    (package / "host.py").write_text("X = 1\n")
+    (package / "msgs" / "core.py").write_text("Y = 2\n")
+    monkeypatch.setattr(bwrap, "sandbox_package_dir", lambda: str(package))
+    assert bwrap.precompile_package()
+    assert list((package / "__pycache__").glob("host.*.pyc"))
+    assert list((package / "msgs" / "__pycache__").glob("core.*.pyc"))
