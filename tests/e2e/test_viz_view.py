@@ -14,6 +14,7 @@ import io
 import time
 
 import numpy as np
+import pytest
 from PIL import Image
 from playwright.sync_api import expect
 from scipy import ndimage
@@ -22,6 +23,8 @@ from server.exercises.grading import reference_nodes
 from server.exercises.registry import get_exercise
 from server.viz.robot_drawing import BODY_RGB
 from tests.viz.conftest import TURTLEBOT_ROLL
+
+pytestmark = pytest.mark.slow  # Chromium drives the pages: seconds per test
 
 VIEWPORT = {"width": 1400, "height": 850}
 MIN_ROBOT_PX = 5_000  # [px] the floor for "clearly visible" at 1400x850

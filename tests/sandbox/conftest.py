@@ -67,7 +67,9 @@ class WarmOnlyLauncher(Launcher):
         return super().start(name)
 
 
-@pytest.fixture(scope="module", params=["warm", "cold"])
+# The warm half waits for the pool to refill before every node (seconds per test): the fast
+# set (-m "not slow") runs every attack on cold nodes only; the full suite runs both.
+@pytest.fixture(scope="module", params=[pytest.param("warm", marks=pytest.mark.slow), "cold"])
 def warm_and_cold_launcher(request):
     """A launcher whose nodes all come from the warm pool, then one whose nodes all start cold
     (importing numpy and the rest only when the student's code does)."""
