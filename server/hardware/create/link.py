@@ -17,13 +17,12 @@ it still obeys.
 
 from __future__ import annotations
 
-import threading
 import time
-from collections import deque
 
 from server.hardware.create.driver import CreateDriver, CreateState
 from server.hardware.create.topics import TOPIC_BUMPER, TOPIC_CMD_VEL, TOPIC_ODOM
 from server.hardware.health import LinkHealth
+from server.hardware.inbox import Received, ReceivedInbox
 
 INBOX_MAX = 1000  # messages waiting for a run: 25 s of odom + bumper at 20 Hz; older ones go
 
@@ -39,8 +38,7 @@ class CreateLink:
         if baud is not None:
             options["baud"] = baud
         self.driver = CreateDriver(port, on_message=self._push, **options)
-        self._inbox: deque[tuple[str, object, float]] = deque(maxlen=inbox_max)
-        self._lock = threading.Lock()
+        self._inbox = ReceivedInbox(inbox_max)
         self._heard_s: float | None = None  # [s] monotonic, the latest message
 
     def open(self) -> None:
@@ -81,20 +79,15 @@ class CreateLink:
             )
         self.driver.command(message)
 
-    def take_received(self) -> list[tuple[str, object, float]]:
+    def take_received(self) -> list[Received]:
         """(topic, message, monotonic receive time [s]) since the last call."""
-        with self._lock:
-            taken = list(self._inbox)
-            self._inbox.clear()
-        return taken
+        return self._inbox.take()
 
     def drain(self) -> None:
         """Forget what arrived before a run started."""
-        with self._lock:
-            self._inbox.clear()
+        self._inbox.clear()
 
     def _push(self, topic: str, message: object) -> None:
         now_s = time.monotonic()
-        with self._lock:
-            self._inbox.append((topic, message, now_s))
-            self._heard_s = now_s
+        self._inbox.push(topic, message, now_s)
+        self._heard_s = now_s

@@ -19,6 +19,7 @@ from collections import deque
 
 from server.hardware.backend import RobotLost
 from server.hardware.health import LinkHealth
+from server.hardware.inbox import Received, ReceivedInbox
 from server.hardware.rosserial.server import RobotConnection
 from server.hardware.rosserial.session import RobotDisconnected, SessionState
 
@@ -34,8 +35,8 @@ class RosserialLink:
         self.name = name
         self._lost = False
         self.lost_reason = ""
-        self._inbox: deque[tuple[str, object, float]] = deque(maxlen=INBOX_MAX)
-        self._lock = threading.Lock()
+        self._inbox = ReceivedInbox(INBOX_MAX)
+        self._lock = threading.Lock()  # the robot's log lines: rosserial thread -> run
         self.logs: deque[str] = deque(maxlen=LOG_LINES_KEPT)  # the instructor's view
         self._new_logs: deque[str] = deque(maxlen=LOG_LINES_KEPT)  # for the run on the robot
 
@@ -68,16 +69,12 @@ class RosserialLink:
             self.lose("robot disconnected")
             raise RobotLost("robot disconnected") from None
 
-    def take_received(self) -> list[tuple[str, object, float]]:
-        with self._lock:
-            taken = list(self._inbox)
-            self._inbox.clear()
-        return taken
+    def take_received(self) -> list[Received]:
+        return self._inbox.take()
 
     def drain(self) -> None:
         """Forget what arrived before a run started."""
-        with self._lock:
-            self._inbox.clear()
+        self._inbox.clear()
 
     def log(self, line: str) -> None:
         self.logs.append(line)
@@ -90,8 +87,7 @@ class RosserialLink:
         return taken
 
     def push(self, topic: str, message: object) -> None:
-        with self._lock:
-            self._inbox.append((topic, message, time.monotonic()))
+        self._inbox.push(topic, message, time.monotonic())
 
     def lose(self, reason: str) -> None:
         self.lost_reason = reason
