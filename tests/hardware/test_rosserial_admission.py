@@ -72,7 +72,11 @@ def wait_for_connection(admin, name: str, predicate, timeout_s: float = 10.0) ->
 
 @pytest.fixture(scope="module")
 def lab(tmp_path_factory) -> Iterator[tuple[LabServer, int]]:
-    server = start_server(tmp_path_factory.mktemp("admission"))
+    # The lab's default bind (every interface: test_rosserial_host_defaults_... checks it); the test
+    # servers otherwise keep rosserial on loopback.
+    server = start_server(
+        tmp_path_factory.mktemp("admission"), env_extra={"ROBODOJO_ROSSERIAL_HOST": "0.0.0.0"}
+    )
     admin = server.admin()
     port = admin.get("/api/admin/status").json()["hardware"]["rosserial_port"]
     made = admin.post(
