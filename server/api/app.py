@@ -29,6 +29,7 @@ from server.api.routes import (
     admin_runs,
     catalog,
     hardware,
+    leaderboards,
     live,
     runs,
     session,
@@ -143,7 +144,7 @@ def create_app(settings: Settings | None = None, launcher: Launcher | None = Non
     app.add_middleware(SecurityHeaders)
 
     for module in (session, catalog, workspaces, runs, live, admin, admin_runs, admin_courses,
-                   admin_exercises, admin_robots, hardware, viz):  # fmt: skip
+                   admin_exercises, admin_robots, hardware, viz, leaderboards):  # fmt: skip
         app.include_router(module.router)
 
     def page(name: str):

@@ -77,6 +77,7 @@ CROP_ROW_FUZZY = Exercise(
     starts=tuple((1.4, LEFT_ROW_Y_M - offset, 0.0) for offset in (0.57, 0.40, 0.28)),
     reference=(("fuzzy_follower", "reference/crop_row_fuzzy.py"),),
     starter=(("fuzzy_follower", "starter/crop_row_fuzzy.py"),),
+    leaderboard_check="settling_time",
     checks=(
         Check(
             "settling_time",

@@ -53,6 +53,7 @@ DISTANCE_PID = Exercise(
     seeds=(1, 2, 3),
     reference=(("pid_distance", "reference/crowbot_distance_pid.py"),),
     starter=(("pid_distance", "starter/crowbot_distance_pid.py"),),
+    leaderboard_check="settling_time",
     checks=(
         Check(
             "settling_time",
@@ -119,6 +120,7 @@ LIGHT_TRACKING = Exercise(
     script=tuple(ScriptEvent(t, Light(x, y, name="lamp")) for t, (x, y) in LAMP_MOVES),
     reference=(("light_tracker", "reference/crowbot_light_tracking.py"),),
     starter=(("light_tracker", "starter/crowbot_light_tracking.py"),),
+    leaderboard_check="heading_error",
     checks=(
         Check(
             "heading_error",
@@ -179,6 +181,7 @@ DATA_LOGGER = Exercise(
     ),
     reference=(("data_logger", "reference/crowbot_data_logger.py"),),
     starter=(("data_logger", "starter/crowbot_data_logger.py"),),
+    leaderboard_check="coverage",
     checks=(
         Check("figure_saved", "a PNG figure was saved", "", Comparison.AT_LEAST, 1, _figure_saved),
         Check(

@@ -69,6 +69,7 @@ IR_SCOUT_AVOIDANCE = Exercise(
         ("compare_distance", "starter/ir_scout_compare_distance.py"),
         ("dc_motor", "starter/ir_scout_dc_motor.py"),
     ),
+    leaderboard_check="distance_travelled",
     checks=(
         Check(
             "distance_travelled",

@@ -84,6 +84,18 @@ class Exercise:
     # Before a run on a real robot, this code must have finished a simulation run of this
     # exercise (server setting ROBODOJO_HARDWARE_GATE switches it off for the whole lab).
     hardware_gate: bool = True
+    # The key figure leaderboards rank equal scores by: the name of one of `checks`, better in
+    # the direction of its Comparison (a settling time lower, a distance travelled higher).
+    # None: equal scores are ranked by who got there first.
+    leaderboard_check: str | None = None
+
+    def key_check(self) -> Check | None:
+        """The check named by `leaderboard_check`, or None (none named, or a custom exercise
+        that left it out of its checks)."""
+        for check in self.checks:
+            if check.name == self.leaderboard_check:
+                return check
+        return None
 
     def code_path(self, relative: str) -> Path:
         return EXERCISE_DIR / relative

@@ -51,6 +51,11 @@ def validate_exercise(exercise: Exercise) -> list[str]:
     names = [check.name for check in exercise.checks]
     if len(set(names)) != len(names):
         problems.append(f"{where}: two checks share a name")
+    if exercise.leaderboard_check is not None and exercise.key_check() is None:
+        problems.append(
+            f"{where}: leaderboard_check '{exercise.leaderboard_check}' is none of its checks "
+            f"({', '.join(names)})"
+        )
     for label, files in (("reference", exercise.reference), ("starter", exercise.starter)):
         if not files:
             problems.append(f"{where}: has no {label} code")

@@ -113,6 +113,7 @@ TURTLEBOT_STANLEY = Exercise(
     },
     reference=(("stanley", "reference/turtlebot_stanley.py"),),
     starter=(("stanley", "starter/turtlebot_stanley.py"),),
+    leaderboard_check="finish_time",
     checks=(
         Check(
             "waypoints_reached",
@@ -194,6 +195,7 @@ TURTLEBOT_STANLEY_ROS2 = Exercise(
         ("stanley", "starter/turtlebot_stanley_ros2.py"),
         ("mission", "starter/turtlebot_mission_ros2.py"),
     ),
+    leaderboard_check=TURTLEBOT_STANLEY.leaderboard_check,
     checks=TURTLEBOT_STANLEY.checks,  # graded exactly as the ROS 1 exercise
 )
 

@@ -22,7 +22,14 @@ from sqlalchemy.orm import Session as Db
 
 from server.runs.state import RunState
 from server.store.accounts import Role
-from server.store.models import Course, CourseExercise, Enrolment, RunRecord, User
+from server.store.models import (
+    Course,
+    CourseExercise,
+    Enrolment,
+    LeaderboardSetting,
+    RunRecord,
+    User,
+)
 
 
 class CourseNameTakenError(ValueError):
@@ -60,13 +67,15 @@ def list_courses(db: Db) -> list[Course]:
 
 
 def delete_course(db: Db, course_id: str) -> bool:
-    """False when there is no such course. Enrolments and the exercise list go with it."""
+    """False when there is no such course. Enrolments, the exercise list and the leaderboard
+    settings go with it."""
     course = get(db, course_id)
     if course is None:
         return False
     # Explicit, not left to ON DELETE CASCADE: SQLite enforces it only with foreign_keys=ON.
     db.execute(delete(Enrolment).where(Enrolment.course_id == course_id))
     db.execute(delete(CourseExercise).where(CourseExercise.course_id == course_id))
+    db.execute(delete(LeaderboardSetting).where(LeaderboardSetting.course_id == course_id))
     db.delete(course)
     db.flush()
     return True

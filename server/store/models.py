@@ -178,3 +178,20 @@ class RobotEntry(Base):
     watchdog_s: Mapped[float] = mapped_column(Float)
     in_service: Mapped[bool] = mapped_column(Boolean, default=True)
     created_at: Mapped[float] = mapped_column(Float)
+
+
+class LeaderboardSetting(Base):
+    """How an instructor set one exercise's leaderboard in one course. No row: the defaults
+    (shown, with pseudonyms, never reset)."""
+
+    __tablename__ = "leaderboards"
+
+    course_id: Mapped[str] = mapped_column(
+        ForeignKey("courses.id", ondelete="CASCADE"), primary_key=True
+    )
+    exercise_id: Mapped[str] = mapped_column(String(64), primary_key=True)
+    visible: Mapped[bool] = mapped_column(Boolean, default=True)  # False: students get 404
+    names: Mapped[str] = mapped_column(String(16))  # "names" | "pseudonyms"
+    # Runs created before this (epoch [s]) do not count; None: never reset.
+    reset_at: Mapped[float | None] = mapped_column(Float, nullable=True)
+    updated_at: Mapped[float] = mapped_column(Float)
