@@ -49,6 +49,16 @@ RUN_ROUTES = {
 # Routes on the caller's own things with no id of someone else's in them: another student
 # reaches only their own (empty) data; shown by test_workspaces_are_private.
 OWN_ROUTES = {"/api/workspaces/", "/api/me", "/api/logout", "/api/session", "/api/hardware"}
+# Routes on a course's leaderboards: a student reaches only their own courses' boards (another's
+# is 404, like one that does not exist) and gets 404 on the instructor's; shown by
+# tests/api/test_leaderboards.py::test_a_student_sees_only_their_own_courses_boards.
+BOARD = "/api/courses/{course_id}/leaderboards/{exercise_id}"
+COURSE_ROUTES = {
+    ("GET", "/api/courses"),
+    ("GET", BOARD),
+    ("PUT", f"{BOARD}/settings"),
+    ("POST", f"{BOARD}/reset"),
+}
 PUBLIC_ROUTES = {"/login", "/", "/admin", "/api/health"}
 
 
@@ -77,6 +87,8 @@ def test_every_route_is_covered():
             continue
         if path.startswith("/api/admin/"):
             continue  # test_students_get_404_on_every_admin_route takes them all
+        if (method, path) in COURSE_ROUTES:
+            continue
         if "{run_id}" in path:
             assert (method, path) in RUN_ROUTES or method == "WS", f"untested: {method} {path}"
             continue

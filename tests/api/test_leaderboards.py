@@ -165,6 +165,10 @@ def test_a_student_sees_only_their_own_courses_boards(lab, store):
         add_run(store, kurt.user["id"], 1.0, 3.0, time.time() - 10)
         assert admin.get(board_path(theirs["id"])).status_code == 200
 
+    anonymous = lab.client()
+    for url in ("/api/courses", board_path(mine["id"])):
+        assert anonymous.get(url).status_code == 401
+        assert "invite link" in anonymous.get(url).json()["detail"]
     listed = alan.get("/api/courses").json()["courses"]
     assert [c["id"] for c in listed] == [mine["id"]] and listed[0]["exercises"] == [EXERCISE]
     other = alan.get(board_path(theirs["id"]))
