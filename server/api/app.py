@@ -28,6 +28,7 @@ from server.api.routes import (
     admin_robots,
     admin_runs,
     catalog,
+    comparison,
     hardware,
     leaderboards,
     live,
@@ -143,8 +144,9 @@ def create_app(settings: Settings | None = None, launcher: Launcher | None = Non
     app.add_middleware(BodyLimit, max_bytes=settings.max_request_body_bytes)
     app.add_middleware(SecurityHeaders)
 
-    for module in (session, catalog, workspaces, runs, live, admin, admin_runs, admin_courses,
-                   admin_exercises, admin_robots, hardware, viz, leaderboards):  # fmt: skip
+    for module in (session, catalog, workspaces, runs, comparison, live, admin, admin_runs,
+                   admin_courses, admin_exercises, admin_robots, hardware, viz,
+                   leaderboards):  # fmt: skip
         app.include_router(module.router)
 
     def page(name: str):

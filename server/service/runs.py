@@ -70,6 +70,7 @@ class RunRequest:
     seed: int | None
     teleop: bool = False  # the teleop built-in: arrow keys from the browser drive the robot
     hardware: str | None = None  # a robot on the bench (inventory name) instead of simulation
+    simulation_run: str | None = None  # a hardware run: the simulation run that passed its gate
     params: dict[str, object] = field(default_factory=dict)  # a launch file's global <param>s
     files: tuple[tuple[str, bytes], ...] = ()  # workspace data files, into every node's folder
 
@@ -242,6 +243,7 @@ class RunService:
                 checks=[],
                 run_dir=str(run_dir),
                 hardware=request.hardware,
+                simulation_run_id=request.simulation_run if request.hardware else None,
             )
             # The robot is claimed before the run is stored: a refused run (not your turn, not
             # connected) leaves no record, like any other refused request, instead of a run

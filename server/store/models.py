@@ -147,6 +147,9 @@ class RunRecord(Base):
     # disk budgets add these up instead of walking every directory (server/service/disk.py).
     disk_bytes: Mapped[int | None] = mapped_column(BigInteger, nullable=True)
     files_removed_at: Mapped[float | None] = mapped_column(Float, nullable=True)  # by retention
+    # A hardware run: the simulation run of the same code that passed its gate, for the
+    # sim-vs-real comparison (server/service/comparison.py). None for simulation runs.
+    simulation_run_id: Mapped[str | None] = mapped_column(String(ID_LENGTH), nullable=True)
 
 
 class LabSetting(Base):

@@ -41,6 +41,7 @@ RUN_ROUTES = {
     ("GET", "/api/runs/{run_id}/logs/{node}.log"): "/api/runs/{id}/logs/saver.log",
     ("GET", "/api/runs/{run_id}/metrics.json"): "/api/runs/{id}/metrics.json",
     ("GET", "/api/runs/{run_id}/graph"): "/api/runs/{id}/graph",
+    ("GET", "/api/runs/{run_id}/comparison"): "/api/runs/{id}/comparison",  # 409: a sim run
     ("GET", "/api/runs/{run_id}/viz"): "/api/runs/{id}/viz",
     ("GET", "/api/runs/{run_id}/viz/{asset:path}"): "/api/runs/{id}/viz/",
     ("GET", "/api/runs/{run_id}/artifacts"): "/api/runs/{id}/artifacts",

@@ -59,6 +59,7 @@ def run_out(record: RunRecord, service: RunService, with_code: bool = False) -> 
         "duration_s": record.duration_s,
         "seed": record.seed,
         "hardware": record.hardware,
+        "simulation_run": record.simulation_run_id,  # a hardware run: the gate's simulation run
         "state": _live_state(live.state) if live else record.state,
         "reason": record.reason,
         "created_at": iso(record.created_at),
@@ -83,6 +84,9 @@ def run_out(record: RunRecord, service: RunService, with_code: bool = False) -> 
             "viz": f"/api/runs/{record.id}/viz/",
         },
     }
+    if record.simulation_run_id is not None:  # sim-vs-real: this robot run against its gate run
+        out["links"]["comparison"] = f"/api/runs/{record.id}/comparison"
+        out["links"]["simulation_run"] = f"/api/runs/{record.simulation_run_id}"
     if with_code:
         out["code"] = record.code
     if live is not None:
@@ -171,7 +175,8 @@ def create(body: RunCreate, request: Request, caller: Caller = Depends(current_u
     gated = request.app.state.settings.hardware_gate and (
         entry is None or entry.exercise.hardware_gate
     )
-    if body.hardware is not None and gated:
+    simulation_run = None  # the simulation run of this code, kept for the sim-vs-real report
+    if body.hardware is not None:
         from server.api.routes.hardware import gate_refusal, simulation_gate
 
         robot = entry.exercise.robot if entry else body.robot
@@ -179,8 +184,9 @@ def create(body: RunCreate, request: Request, caller: Caller = Depends(current_u
             request, caller.id, entry.exercise.id if entry else None, robot,
             [{"name": n.name, "code": n.code} for n in nodes],
         )  # fmt: skip
-        if not verdict["passed"]:
+        if gated and not verdict["passed"]:
             return gate_refusal(verdict)
+        simulation_run = verdict["simulation_run"]  # None where a waived gate found none
     request_ = RunRequest(
         robot=body.robot,
         world=body.world,
@@ -188,6 +194,7 @@ def create(body: RunCreate, request: Request, caller: Caller = Depends(current_u
         nodes=nodes,
         teleop=body.teleop,
         hardware=body.hardware,
+        simulation_run=simulation_run,
         clock=Clock(body.clock) if body.clock else None,
         duration_s=body.duration,
         seed=body.seed,
