@@ -56,7 +56,17 @@ def add_run(
                 code=[],
                 metrics={},
                 nodes={},
-                checks=[{"name": "settling_time", "value": settling_s, "unit": "s"}],
+                checks=[
+                    {
+                        "name": "settling_time",
+                        "description": "time until the distance stays within 2 cm of 0.2 m",
+                        "value": settling_s,
+                        "threshold": 20.0,
+                        "comparison": "<=",
+                        "unit": "s",
+                        "passed": score == 1.0,
+                    }
+                ],
                 score=score,
                 run_dir="/nonexistent",
             )

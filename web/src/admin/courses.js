@@ -6,6 +6,7 @@ import { ApiError, api } from "../common/api.js";
 import { parseCsv } from "../common/csv.js";
 import { h } from "../common/dom.js";
 import { $, $$, busy, clearError, clearRowError, rowError, setOptions, showError, timeEl } from "./dom.js";
+import { showBoards } from "./leaderboards.js";
 import { watchUrl } from "./runs.js";
 import { exerciseTitle, loadCourses, loadUsers, state, subscribe } from "./state.js";
 
@@ -149,6 +150,7 @@ function renderDetail() {
     $("#course-students tbody").append(h("tr", {}, h("td", { colspan: 4, class: "muted" }, "No student enrolled yet.")));
   }
   renderEnrolList();
+  showBoards(course);
 }
 
 function renderEnrolList() {

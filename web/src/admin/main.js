@@ -9,6 +9,7 @@ import { $, $$, copyText } from "./dom.js";
 import { initCourses, showCourses } from "./courses.js";
 import { initExercises, showExercises } from "./exercises.js";
 import { initHardware, showHardware } from "./hardware.js";
+import { initBoards } from "./leaderboards.js";
 import { initRuns, showRuns } from "./runs.js";
 import { loadCourses, loadExercises, loadUsers, state } from "./state.js";
 import { startStatus, stopStatus, refreshStatus } from "./status.js";
@@ -144,6 +145,7 @@ async function start() {
   initRuns();
   initExercises();
   initCourses();
+  initBoards();
   initHardware();
 
   let me;

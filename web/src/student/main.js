@@ -14,6 +14,7 @@ import { graphShown, initGraph } from "./graph.js";
 import { initHardware } from "./hardware.js";
 import { initHistory } from "./history.js";
 import { initLatency } from "./latency.js";
+import { initLeaderboard } from "./leaderboard.js";
 import { initPlots } from "./plots.js";
 import { initRunner, showRun, start } from "./runner.js";
 import { app, on } from "./state.js";
@@ -179,6 +180,7 @@ async function boot() {
   initViz();
   initFiles();
   initHistory();
+  initLeaderboard();
   const viewTabs = tabs(byId("view-tabs"), (panelId) => {
     if (panelId === "panel-viz") vizShown();
     if (panelId === "panel-graph") graphShown();
