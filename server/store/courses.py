@@ -110,6 +110,22 @@ def members(db: Db, course_id: str) -> list[User]:
     )
 
 
+def is_member(db: Db, course_id: str, user_id: str) -> bool:
+    return db.get(Enrolment, (course_id, user_id)) is not None
+
+
+def courses_of(db: Db, user_id: str) -> list[Course]:
+    """The courses a user is enrolled in, by name."""
+    return list(
+        db.scalars(
+            select(Course)
+            .join(Enrolment, Enrolment.course_id == Course.id)
+            .where(Enrolment.user_id == user_id)
+            .order_by(Course.name)
+        )
+    )
+
+
 def member_count(db: Db, course_id: str) -> int:
     query = select(func.count()).select_from(Enrolment).where(Enrolment.course_id == course_id)
     return db.scalar(query) or 0

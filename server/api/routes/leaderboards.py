@@ -37,9 +37,7 @@ def _my_course(db, caller: Caller, course_id: str) -> Course:
     """The course, if the caller may see it: an instructor any, a student their own (another
     course is answered exactly like one that does not exist)."""
     course = courses.get(db, course_id)
-    if course is not None and (
-        caller.is_instructor or any(u.id == caller.id for u in courses.members(db, course_id))
-    ):
+    if course is not None and (caller.is_instructor or courses.is_member(db, course_id, caller.id)):
         return course
     raise HTTPException(
         404, f"no course '{course_id}' of yours; GET /api/courses lists the courses you are in"
@@ -117,11 +115,7 @@ def my_courses(request: Request, caller: Caller = Depends(current_user)) -> dict
         if caller.is_instructor:
             listed = courses.list_courses(db)
         else:
-            listed = [
-                c
-                for c in courses.list_courses(db)
-                if any(u.id == caller.id for u in courses.members(db, c.id))
-            ]
+            listed = courses.courses_of(db, caller.id)
         return {
             "courses": [
                 {"id": c.id, "name": c.name, "exercises": courses.exercises(db, c.id)}
