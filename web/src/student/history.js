@@ -5,6 +5,7 @@
 import { api } from "../common/api.js";
 import { byId, fill, h, when } from "../common/dom.js";
 import { leaveWatch } from "./catalog.js";
+import { showComparison } from "./compare.js";
 import { checkChip, showRun } from "./runner.js";
 import { app, END_STATES, on } from "./state.js";
 
@@ -69,6 +70,13 @@ function render() {
             { type: "button", class: "small", disabled: current, onclick: () => open(run), dataset: { testid: "history-open" }, "aria-label": `Open the run of ${when(run.created_at)}` },
             current ? "On show" : END_STATES.has(run.state) ? "Open" : "Follow",
           ),
+          run.links?.comparison && END_STATES.has(run.state)
+            ? h(
+                "button",
+                { type: "button", class: "small", onclick: () => compare(run, current), dataset: { testid: "history-compare" }, "aria-label": `Compare the robot run of ${when(run.created_at)} with its simulation run` },
+                "Sim vs real",
+              )
+            : null,
         ),
         run.reason && run.state !== "finished" ? h("p", { class: "history-reason" }, run.reason) : null,
         checks.length ? h("div", { class: "checks small" }, checks.map(checkChip)) : null,
@@ -81,6 +89,12 @@ function render() {
 function open(run) {
   leaveWatch();
   showRun(run);
+}
+
+/** A robot run beside its simulation run: put it on show (unless it is), then the Sim vs real view. */
+function compare(run, current) {
+  if (!current) open(run);
+  showComparison();
 }
 
 function target(run) {

@@ -6,6 +6,7 @@ import { api } from "../common/api.js";
 import { byId, fill, h, when } from "../common/dom.js";
 import { tabs } from "../common/tabs.js";
 import { initCatalog, leaveWatch } from "./catalog.js";
+import { initCompare } from "./compare.js";
 import { initConsole } from "./console.js";
 import { initEditor } from "./editor.js";
 import { initEstop } from "./estop.js";
@@ -181,6 +182,7 @@ async function boot() {
   initFiles();
   initHistory();
   initLeaderboard();
+  initCompare();
   const viewTabs = tabs(byId("view-tabs"), (panelId) => {
     if (panelId === "panel-viz") vizShown();
     if (panelId === "panel-graph") graphShown();
@@ -189,6 +191,7 @@ async function boot() {
   byId("lab").hidden = false;
   app.watching = await runOfAddress();
   on("watch-ended", () => (notice.hidden = true));
+  on("show-view", ({ panel }) => viewTabs.select(panel));
   on("drive", () => {
     viewTabs.select("panel-world");
     document.querySelector('[data-testid="teleop-pad"]')?.focus();

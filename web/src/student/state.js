@@ -18,6 +18,7 @@
 //   watch-ended {}                 the run opened by its id is left for the student's own code
 //   files      {names}             the workspace's files changed (added, deleted, loaded)
 //   file-shown {filename}          the editor shows this file
+//   show-view  {panel}             select this view tab (e.g. "panel-compare" from the history)
 
 export const app = {
   me: null,
