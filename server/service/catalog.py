@@ -136,6 +136,8 @@ def describe(entry: ExerciseEntry) -> dict:
         "clock": str(exercise.clock),
         "custom": entry.custom,
         "builtin_nodes": list(exercise.builtin_nodes),
+        # What its leaderboards rank equal scores by (None: by who got there first).
+        "leaderboard_check": key.name if (key := exercise.key_check()) else None,
         "starter": [
             {"name": name, "filename": filename, "code": code}
             for name, filename, code in entry.starter

@@ -29,6 +29,20 @@ def test_registry_entries_are_valid(exercise_id):
     assert validate_exercise(get_exercise(exercise_id)) == []
 
 
+@pytest.mark.parametrize("exercise_id", exercise_ids())
+def test_every_exercise_names_its_leaderboard_key_figure(exercise_id):
+    """Leaderboards rank equal scores by it: a registry exercise without one ranks by who was
+    first, which tells students nothing about how good their controller is."""
+    assert get_exercise(exercise_id).key_check() is not None
+
+
+def test_a_leaderboard_check_that_is_no_check_is_refused():
+    exercise = dataclasses.replace(get_exercise("crowbot_distance_pid"), leaderboard_check="speed")
+    problems = validate_exercise(exercise)
+    assert len(problems) == 1 and "leaderboard_check 'speed'" in problems[0]
+    assert "settling_time" in problems[0]  # the checks it could name
+
+
 def test_unknown_exercise_lists_the_valid_ids():
     with pytest.raises(UnknownExerciseError, match="crowbot_distance_pid"):
         get_exercise("crowbot_distnce_pid")
