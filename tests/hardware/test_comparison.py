@@ -123,3 +123,30 @@ def test_a_hardware_run_is_compared_with_the_simulation_run_that_passed_its_gate
     assert bench.admin().get(real["links"]["comparison"]).status_code == 200
     other = bench.student("bob").get(real["links"]["comparison"])
     assert other.status_code == 404 and other.json()["detail"] == "no such run (or it is not yours)"
+
+
+def test_a_robot_run_without_a_simulation_run_says_so(bench):
+    admin = bench.admin()
+    made = admin.post(
+        "/api/admin/exercises",
+        json={"id": "bench_no_gate", "title": "Drive on the bench", "robot": "crowbot",
+              "world": "wall_approach", "duration_s": 1, "hardware_gate": False,
+              "starter": [{"name": "approach", "code": ROSPY}],
+              "checks": [{"name": "collisions", "threshold": 0}]},
+    )  # fmt: skip
+    assert made.status_code == 201, made.text
+    student = bench.student("cleo")
+    student.post("/api/hardware/crowbot-1/queue")
+    started = student.post(
+        "/api/runs",
+        json={"exercise": "bench_no_gate", "hardware": "crowbot-1",
+              "nodes": [{"name": "approach", "code": ROSPY}]},
+    )  # fmt: skip
+    assert started.status_code == 201, started.text
+    run = wait_for_end(student, started.json()["id"], timeout_s=30)
+    assert run["simulation_run"] is None and "comparison" not in run["links"]
+    answer = student.get(f"/api/runs/{run['id']}/comparison")
+    assert answer.status_code == 409
+    assert "has no simulation run linked" in answer.json()["detail"]
+    assert "run the same code in simulation" in answer.json()["detail"]
+    admin.delete("/api/admin/exercises/bench_no_gate")
