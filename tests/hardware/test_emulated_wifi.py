@@ -66,7 +66,11 @@ class WifiBench:
 
 @pytest.fixture(scope="module")
 def bench(tmp_path_factory) -> Iterator[WifiBench]:
-    server = start_server(tmp_path_factory.mktemp("wifi"))
+    # The robot reaches the lab from its namespace, not from loopback: rosserial listens on
+    # every interface, as the lab does by default (the test servers otherwise keep loopback).
+    server = start_server(
+        tmp_path_factory.mktemp("wifi"), env_extra={"ROBODOJO_ROSSERIAL_HOST": "0.0.0.0"}
+    )
     wifi = EmulatedWifi()
     robot: RobotProcess | None = None
     try:
