@@ -6,7 +6,9 @@
     reset(db, course_id, exercise_id, time.time())             # older runs stop counting
 
 A graded run is what the grade book (courses.grades) counts: a finished run of the exercise with
-a score. A student's best is the highest score, then the better key figure (the exercise's
+a score; a board ranks simulated runs only (a real robot's figures come from other conditions
+and a queue for the robot: the grade book keeps them, the sim-vs-real report compares them). A
+student's best is the highest score, then the better key figure (the exercise's
 `leaderboard_check`, in its check's direction), then the earlier run; the board is ordered the
 same way, so ranks are 1..n without ties. A run with no value for the key figure (the robot never
 settled) is behind every run with one at the same score.
@@ -186,6 +188,7 @@ def board(
             RunRecord.exercise_id == exercise_id,
             RunRecord.state == str(RunState.FINISHED),
             RunRecord.score.is_not(None),
+            RunRecord.hardware.is_(None),  # simulated runs only (see the module docstring)
         )
     )
     if since is not None:

@@ -37,6 +37,7 @@ def add_run(
     created_at: float,
     state: str = "finished",
     exercise: str = EXERCISE,
+    hardware: str | None = None,
 ) -> str:
     run_id = uuid.uuid4().hex
     with store.session() as db:
@@ -69,6 +70,7 @@ def add_run(
                 ],
                 score=score,
                 run_dir="/nonexistent",
+                hardware=hardware,
             )
         )
     return run_id
@@ -109,6 +111,8 @@ def test_ranking_by_score_then_key_figure_then_earlier_run(lab, store):
         # exercise here: the session-wide grade book without a course would list it for every
         # student, and test_admin_courses counts their rows.)
         add_run(store, claude.user["id"], 1.0, 0.5, t0 + 6, state="failed")
+        # Nor does a run on a real robot: boards compare simulated runs.
+        add_run(store, claude.user["id"], 1.0, 0.4, t0 + 7, hardware="crowbot-1")
         # Ada's worse try later does not replace her best.
         add_run(store, ada.user["id"], 0.5, 1.0, t0 + 8)
         instructor_view = admin.get(board_path(course["id"]))
