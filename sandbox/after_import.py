@@ -48,7 +48,19 @@ class _PatchingLoader:
         return getattr(self._inner, name)
 
 
-class AfterImport:
+class _MetaPathHook:
+    """A finder at the front of sys.meta_path, put there once and taken out again."""
+
+    def install(self) -> None:
+        if self not in sys.meta_path:
+            sys.meta_path.insert(0, self)
+
+    def remove(self) -> None:
+        if self in sys.meta_path:
+            sys.meta_path.remove(self)
+
+
+class AfterImport(_MetaPathHook):
     """Calls `patch(module)` once `name` is imported (at once if it already is)."""
 
     def __init__(self, name: str, patch: Patch) -> None:
@@ -60,11 +72,7 @@ class AfterImport:
         if module is not None:
             self._patch(module)
             return
-        sys.meta_path.insert(0, self)
-
-    def remove(self) -> None:
-        if self in sys.meta_path:
-            sys.meta_path.remove(self)
+        super().install()
 
     def find_spec(
         self,
@@ -85,21 +93,13 @@ class AfterImport:
         return None
 
 
-class BeforeImport:
+class BeforeImport(_MetaPathHook):
     """Calls `announce()` when a top-level package in `names` is about to be imported for the
     first time in this process (a package already in sys.modules is never searched for)."""
 
     def __init__(self, names: set[str], announce: Callable[[], None]) -> None:
         self.names = frozenset(names)
         self._announce = announce
-
-    def install(self) -> None:
-        if self not in sys.meta_path:
-            sys.meta_path.insert(0, self)
-
-    def remove(self) -> None:
-        if self in sys.meta_path:
-            sys.meta_path.remove(self)
 
     def find_spec(
         self,
