@@ -215,6 +215,22 @@ def _close_clients(request) -> Iterator[None]:
         request.getfixturevalue("lab").close_clients()
 
 
+def start_crowbot_run(client, clock: str = "realtime", duration_s: float = 60.0) -> str:
+    """Start STEP_CONTROLLER on a CrowBot at the wall (201 expected); the run's id."""
+    answer = client.post(
+        "/api/runs",
+        json={
+            "robot": "crowbot",
+            "world": "wall_approach",
+            "nodes": [{"name": "driver", "code": STEP_CONTROLLER}],
+            "clock": clock,
+            "duration": duration_s,
+        },
+    )
+    assert answer.status_code == 201, answer.text
+    return answer.json()["id"]
+
+
 def wait_for_end(client: httpx.Client, run_id: str, timeout_s: float = 60.0) -> dict:
     deadline = time.monotonic() + timeout_s
     while time.monotonic() < deadline:

@@ -13,7 +13,7 @@ from websockets.exceptions import ConnectionClosed, InvalidStatus
 from websockets.sync.client import connect
 
 from server.api.auth import SESSION_COOKIE
-from tests.api.conftest import STEP_CONTROLLER, wait_for_end
+from tests.api.conftest import start_crowbot_run, wait_for_end
 
 OTHER_PORT = "http://127.0.0.1:1"  # another port of the lab's host: same site, other origin
 
@@ -24,21 +24,6 @@ def browser(lab, token: str):
     client.headers["Origin"] = lab.url
     assert client.get(f"/login?token={token}", follow_redirects=False).status_code == 303
     return client
-
-
-def start_run(client, clock: str = "realtime", duration_s: float = 60.0) -> str:
-    answer = client.post(
-        "/api/runs",
-        json={
-            "robot": "crowbot",
-            "world": "wall_approach",
-            "nodes": [{"name": "driver", "code": STEP_CONTROLLER}],
-            "clock": clock,
-            "duration": duration_s,
-        },
-    )
-    assert answer.status_code == 201, answer.text
-    return answer.json()["id"]
 
 
 def live_socket(lab, client, run_id: str, origin: str):
@@ -74,7 +59,7 @@ def test_a_cookie_state_change_from_another_origin_is_refused(lab):
 
 def test_the_live_websocket_refuses_another_origin(lab):
     student = lab.student("watched")
-    run_id = start_run(student, clock="lockstep", duration_s=1.0)
+    run_id = start_crowbot_run(student, clock="lockstep", duration_s=1.0)
     with pytest.raises(InvalidStatus) as refused:
         live_socket(lab, student, run_id, OTHER_PORT)
     assert refused.value.response.status_code == 403
@@ -111,7 +96,7 @@ def test_a_login_link_asks_before_switching_a_signed_in_browser(lab):
 
 def test_disabling_a_user_closes_their_open_live_socket(lab):
     student = lab.student("soon-disabled")
-    run_id = start_run(student)
+    run_id = start_crowbot_run(student)
     with live_socket(lab, student, run_id, lab.url) as ws:
         assert json.loads(ws.recv(timeout=10))["type"] == "snapshot"
         with lab.admin() as admin:
@@ -129,7 +114,7 @@ def test_disabling_a_user_closes_their_open_live_socket(lab):
 
 def test_resume_of_a_running_run_and_pause_of_a_paused_one_answer_409(lab):
     student = lab.student("pauser")
-    run_id = start_run(student, clock="lockstep", duration_s=120.0)
+    run_id = start_crowbot_run(student, clock="lockstep", duration_s=120.0)
     deadline = time.monotonic() + 30
     while student.get(f"/api/runs/{run_id}").json()["state"] != "running":
         assert time.monotonic() < deadline, "the run did not start"

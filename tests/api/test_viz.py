@@ -12,26 +12,11 @@ from websockets.exceptions import ConnectionClosed, InvalidStatus
 from websockets.sync.client import connect
 
 from server.api.auth import SESSION_COOKIE
-from tests.api.conftest import STEP_CONTROLLER, wait_for_end
+from tests.api.conftest import start_crowbot_run, wait_for_end
 from tests.viz.conftest import viser_messages
 
 SUBPROTOCOL = f"viser-v{viser.__version__}"
 ROBOT_WAIT_S = 10.0  # [s] a loaded test machine; the target (bench/bench_viz.py) is < 2 s
-
-
-def start_run(client, duration_s: float = 30.0, clock: str = "realtime") -> str:
-    answer = client.post(
-        "/api/runs",
-        json={
-            "robot": "crowbot",
-            "world": "wall_approach",
-            "nodes": [{"name": "driver", "code": STEP_CONTROLLER}],
-            "clock": clock,
-            "duration": duration_s,
-        },
-    )
-    assert answer.status_code == 201, answer.text
-    return answer.json()["id"]
 
 
 def socket_url(lab, run_id: str) -> str:
@@ -68,7 +53,7 @@ def is_robot_moving(message: dict) -> bool:
 
 def test_the_owner_watches_the_robot_live(lab):
     owner = lab.student("viewer")
-    run_id = start_run(owner)
+    run_id = start_crowbot_run(owner, duration_s=30.0)
     opened = time.monotonic()
     redirect = owner.get(f"/api/runs/{run_id}/viz", follow_redirects=False)
     assert redirect.status_code == 307 and redirect.headers["location"] == "viz/"
@@ -93,7 +78,7 @@ def test_the_owner_watches_the_robot_live(lab):
 
 def test_a_finished_run_replays_with_a_time_slider(lab):
     owner = lab.student("replayer")
-    run_id = start_run(owner, duration_s=1.0, clock="lockstep")
+    run_id = start_crowbot_run(owner, duration_s=1.0, clock="lockstep")
     assert wait_for_end(owner, run_id)["state"] == "finished"
     with browser_socket(lab, owner, run_id) as ws:
         seen = messages_until(ws, lambda m: m["type"] == "GuiSliderMessage")
@@ -104,7 +89,7 @@ def test_a_finished_run_replays_with_a_time_slider(lab):
 
 def test_another_student_gets_what_a_missing_run_gets(lab):
     owner = lab.student("private")
-    run_id = start_run(owner, duration_s=1.0, clock="lockstep")
+    run_id = start_crowbot_run(owner, duration_s=1.0, clock="lockstep")
     stranger = lab.student("stranger")
     for path in (f"/api/runs/{run_id}/viz", f"/api/runs/{run_id}/viz/", "/api/runs/nope/viz/"):
         answer = stranger.get(path, follow_redirects=False)
@@ -118,7 +103,7 @@ def test_another_student_gets_what_a_missing_run_gets(lab):
 
 def test_without_login_401_and_close_4401(lab):
     owner = lab.student("shy")
-    run_id = start_run(owner, duration_s=1.0, clock="lockstep")
+    run_id = start_crowbot_run(owner, duration_s=1.0, clock="lockstep")
     anonymous = lab.client()
     answer = anonymous.get(f"/api/runs/{run_id}/viz/")
     assert answer.status_code == 401 and "invite link" in answer.json()["detail"]
@@ -133,7 +118,7 @@ def test_without_login_401_and_close_4401(lab):
 
 def test_another_sites_page_cannot_open_the_socket_and_a_stale_client_is_told(lab):
     owner = lab.student("careful")
-    run_id = start_run(owner, duration_s=1.0, clock="lockstep")
+    run_id = start_crowbot_run(owner, duration_s=1.0, clock="lockstep")
     with pytest.raises(InvalidStatus) as refused:
         browser_socket(lab, owner, run_id, origin="http://evil.example")
     assert refused.value.response.status_code == 403
@@ -149,7 +134,7 @@ def test_another_sites_page_cannot_open_the_socket_and_a_stale_client_is_told(la
 
 def test_disabling_the_owner_closes_their_3d_view(lab):
     owner = lab.student("disabled-viewer")
-    run_id = start_run(owner, duration_s=60.0)
+    run_id = start_crowbot_run(owner, duration_s=60.0)
     with browser_socket(lab, owner, run_id) as ws:
         messages_until(ws, is_robot_moving)
         with lab.admin() as admin:

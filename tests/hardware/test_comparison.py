@@ -11,7 +11,7 @@ import pytest
 
 from tests.api.conftest import LabServer, start_server, stop_server, wait_for_end
 from tests.hardware.crowbot_firmware import CrowBotFirmware
-from tests.hardware.test_serve_hardware import ROSPY
+from tests.hardware.test_serve_hardware import ROSPY, add_bench_exercise
 from tests.waiting import wait_until
 
 pytestmark = pytest.mark.slow  # a server and an emulated robot for the module, runs on it
@@ -127,14 +127,7 @@ def test_a_hardware_run_is_compared_with_the_simulation_run_that_passed_its_gate
 
 def test_a_robot_run_without_a_simulation_run_says_so(bench):
     admin = bench.admin()
-    made = admin.post(
-        "/api/admin/exercises",
-        json={"id": "bench_no_gate", "title": "Drive on the bench", "robot": "crowbot",
-              "world": "wall_approach", "duration_s": 1, "hardware_gate": False,
-              "starter": [{"name": "approach", "code": ROSPY}],
-              "checks": [{"name": "collisions", "threshold": 0}]},
-    )  # fmt: skip
-    assert made.status_code == 201, made.text
+    add_bench_exercise(admin, "bench_no_gate", duration_s=1)
     student = bench.student("cleo")
     student.post("/api/hardware/crowbot-1/queue")
     started = student.post(

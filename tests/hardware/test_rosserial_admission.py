@@ -26,7 +26,7 @@ from server.hardware.rosserial import (
 )
 from tests.api.conftest import LabServer, start_server, stop_server, wait_for_end
 from tests.hardware.crowbot_firmware import CrowBotFirmware
-from tests.hardware.test_serve_hardware import ROSPY
+from tests.hardware.test_serve_hardware import ROSPY, add_bench_exercise
 from tests.waiting import wait_until
 
 pytestmark = pytest.mark.slow  # a server per module; handshake timeouts take seconds
@@ -83,14 +83,7 @@ def lab(tmp_path_factory) -> Iterator[tuple[LabServer, int]]:
         "/api/admin/robots", json={"name": "crowbot-1", "kind": "crowbot", "address": ROBOT}
     )
     assert made.status_code == 201, made.text
-    made = admin.post(
-        "/api/admin/exercises",
-        json={"id": "bench_drive", "title": "Drive on the bench", "robot": "crowbot",
-              "world": "wall_approach", "duration_s": 6, "hardware_gate": False,
-              "starter": [{"name": "approach", "code": ROSPY}],
-              "checks": [{"name": "collisions", "threshold": 0}]},
-    )  # fmt: skip
-    assert made.status_code == 201, made.text
+    add_bench_exercise(admin, "bench_drive", duration_s=6)
     server.close_clients()
     yield server, port
     stop_server(server)

@@ -37,6 +37,20 @@ while not rospy.is_shutdown():
 """
 
 
+def add_bench_exercise(admin, exercise_id: str, duration_s: float) -> dict:
+    """A custom CrowBot exercise that waives the simulation gate (hardware_gate false), with
+    ROSPY as its starter: a run on the bench needs no simulated run first."""
+    made = admin.post(
+        "/api/admin/exercises",
+        json={"id": exercise_id, "title": "Drive on the bench", "robot": "crowbot",
+              "world": "wall_approach", "duration_s": duration_s, "hardware_gate": False,
+              "starter": [{"name": "approach", "code": ROSPY}],
+              "checks": [{"name": "collisions", "threshold": 0}]},
+    )  # fmt: skip
+    assert made.status_code == 201, made.text
+    return made.json()
+
+
 @pytest.fixture(scope="module")
 def bench(tmp_path_factory) -> Iterator[tuple[LabServer, CrowBotFirmware]]:
     server = start_server(tmp_path_factory.mktemp("bench"))
@@ -284,15 +298,8 @@ def test_out_of_service_holds_the_queue_and_refuses_runs(bench):
 def test_an_exercise_can_waive_the_simulation_gate(bench):
     server, _ = bench
     admin = server.admin()
-    made = admin.post(
-        "/api/admin/exercises",
-        json={"id": "bench_free_drive", "title": "Drive on the bench", "robot": "crowbot",
-              "world": "wall_approach", "duration_s": 2, "hardware_gate": False,
-              "starter": [{"name": "approach", "code": ROSPY}],
-              "checks": [{"name": "collisions", "threshold": 0}]},
-    )  # fmt: skip
-    assert made.status_code == 201, made.text
-    assert made.json()["hardware_gate"] is False
+    made = add_bench_exercise(admin, "bench_free_drive", duration_s=2)
+    assert made["hardware_gate"] is False
     student = server.student("hal")
     student.post("/api/hardware/crowbot-1/queue")
     started = student.post(

@@ -56,6 +56,12 @@ def _exercise(db, course: Course, exercise_id: str):
     return exercises.find(db, exercise_id).exercise  # UnknownIdError: 404 with the valid ids
 
 
+def _course_and_exercise(db, caller: Caller, course_id: str, exercise_id: str):
+    """The course the caller may see and the exercise of it a board is about (404s as above)."""
+    course = _my_course(db, caller, course_id)
+    return course, _exercise(db, course, exercise_id)
+
+
 def _settings_out(board: BoardSettings) -> dict:
     return {"visible": board.visible, "names": str(board.names), "reset_at": iso(board.reset_at)}
 
@@ -132,8 +138,7 @@ def get_board(
     course_id: str, exercise_id: str, request: Request, caller: Caller = Depends(current_user)
 ) -> dict:
     with request.app.state.store.session() as db:
-        course = _my_course(db, caller, course_id)
-        exercise = _exercise(db, course, exercise_id)
+        course, exercise = _course_and_exercise(db, caller, course_id, exercise_id)
         board = leaderboards.settings(db, course.id, exercise.id)
         if not board.visible and not caller.is_instructor:
             raise HTTPException(
@@ -156,8 +161,7 @@ def put_settings(
     caller: Caller = Depends(instructor),
 ) -> dict:
     with request.app.state.store.session() as db:
-        course = _my_course(db, caller, course_id)
-        exercise = _exercise(db, course, exercise_id)
+        course, exercise = _course_and_exercise(db, caller, course_id, exercise_id)
         board = leaderboards.set_settings(db, course.id, exercise.id, body.visible, body.names)
         return {"course": course.id, "exercise": exercise.id, **_settings_out(board)}
 
@@ -170,8 +174,7 @@ def reset_board(
     course_id: str, exercise_id: str, request: Request, caller: Caller = Depends(instructor)
 ) -> dict:
     with request.app.state.store.session() as db:
-        course = _my_course(db, caller, course_id)
-        exercise = _exercise(db, course, exercise_id)
+        course, exercise = _course_and_exercise(db, caller, course_id, exercise_id)
         board = leaderboards.reset(db, course.id, exercise.id, time.time())
         return {
             "course": course.id,
