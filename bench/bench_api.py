@@ -43,20 +43,12 @@ from __future__ import annotations
 
 import argparse
 import asyncio
-import collections
 import contextlib
-import itertools
 import json
 import math
 import os
-import re
-import signal
-import socket
-import statistics
-import subprocess
 import sys
 import tempfile
-import threading
 import time
 from array import array
 from dataclasses import dataclass, field
@@ -64,6 +56,30 @@ from pathlib import Path
 
 import httpx
 import psutil
+from _common import (
+    HTTP_TIMEOUT_S,
+    MAX_HTTP_IN_FLIGHT,
+    MIB,
+    BenchError,
+    HttpStats,
+    LabProcess,
+    MemorySample,
+    Window,
+    bearer,
+    free_port,
+    loop_lag,
+    p99_ms,
+    percentile,
+    poll_status,
+    row,
+    sample_memory,
+    sample_memory_every,
+    slope,
+    spawn,
+    stop,
+    stop_on_sigterm,
+    wait_until_up,
+)
 from websockets.asyncio.client import connect
 from websockets.exceptions import WebSocketException
 
@@ -82,23 +98,13 @@ PROBE_ROUTE = "/bench/delivery-latencies"
 MEMORY_ROUTE = "/bench/memory-growth"  # with --tracemalloc: top allocation sites since a reset
 TRACEMALLOC = "--tracemalloc"  # also an argument of the server process
 TOP_GROWTH_LINES = 12  # allocation sites listed by --tracemalloc
-LOGIN_LINE = re.compile(r"log in as the instructor at \S+/login\?token=(\S+)")
 
-SERVER_START_TIMEOUT_S = 60.0  # [s] cold start with a sandbox pool on a loaded 2-core machine
 RUNS_RUNNING_TIMEOUT_S = 180.0  # [s] N cold sandbox starts one after another under load
 VIEWERS_READY_TIMEOUT_S = 60.0  # [s] every viewer connected and its subscription acknowledged
 RUN_MARGIN_S = 60.0  # [s] runs last this much past the measurement, so none ends inside it
-HTTP_TIMEOUT_S = 10.0  # [s] a status answer slower than this counts as an error
-MAX_HTTP_IN_FLIGHT = 64  # open-loop requests pending at once; more are counted as skipped
 TRACEMALLOC_TIMEOUT_S = 300.0  # [s] a heap snapshot of a loaded server, compared
 PROBE_EVERY_S = 2.0  # [s] RunTelemetry keeps 10,000 latencies per run: read well before that
-LOOP_TICK_S = 0.1  # [s] period of the client event-loop lag probe
 PROGRESS_EVERY_S = 60.0  # [s] one progress line this often during long measurements
-MIB = 2**20
-
-
-class BenchError(RuntimeError):
-    """The benchmark cannot go on; the message says why."""
 
 
 # --------------------------------------------------------------------------- the server process
@@ -114,7 +120,7 @@ def serve_with_probe(argv: list[str]) -> int:
     import server.api.app as app_module
     from server import cli
     from server.api.auth import instructor
-    from server.service.telemetry import UnknownRunError, Viewer
+    from server.service.telemetry import Viewer
 
     plain_frame = Viewer._telemetry_frame
 
@@ -133,12 +139,11 @@ def serve_with_probe(argv: list[str]) -> int:
         # annotations: they would be looked up in this module, where Caller is not imported.
         @app.get(PROBE_ROUTE, include_in_schema=False)
         async def delivery_latencies(_=Depends(instructor)):
-            registry = app.state.runs.telemetry
+            mirrors = app.state.runs.executor.mirrors
             latencies: list[float] = []
-            for run_id in registry.run_ids():
-                try:
-                    telemetry = registry.get(run_id)
-                except UnknownRunError:
+            for run_id in mirrors.run_ids():
+                telemetry = mirrors.feed(run_id)
+                if telemetry is None:
                     continue
                 latencies.extend(telemetry._latencies_s)
                 telemetry._latencies_s.clear()
@@ -175,108 +180,29 @@ def serve_with_probe(argv: list[str]) -> int:
     return cli.main(["serve", *argv])
 
 
-@dataclass
-class Server:
-    url: str
-    admin_token: str
-    process: subprocess.Popen
-    output: collections.deque = field(default_factory=lambda: collections.deque(maxlen=60))
-
-    def tail(self) -> str:
-        return "\n".join(self.output)
-
-
-def free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return sock.getsockname()[1]
-
-
 def start_server(
     data: Path, env_extra: dict[str, str], probe: bool, trace_memory: bool = False
-) -> Server:
+) -> LabProcess:
     """The same start as tests/api/conftest.py's start_server, with the probe's command."""
     port = free_port()
-    env = {**os.environ, "PYTHONUNBUFFERED": "1", **env_extra}
-    serve = [__file__, SERVE_WITH_PROBE] if probe else ["-m", "server.cli", "serve"]
+    serve = (
+        [str(Path(__file__).resolve()), SERVE_WITH_PROBE]
+        if probe
+        else ["-m", "server.cli", "serve"]
+    )
     command = [sys.executable, *serve, "--port", str(port), "--data", str(data)]
     if trace_memory:
         command.append(TRACEMALLOC)
-    process = subprocess.Popen(
-        command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env
-    )
-    server = Server(f"http://127.0.0.1:{port}", "", process)
-
-    def pump() -> None:
-        assert process.stdout is not None
-        try:
-            for line in process.stdout:
-                server.output.append(line.rstrip("\n"))
-                match = LOGIN_LINE.search(line)
-                if match:
-                    server.admin_token = match.group(1)
-        except (ValueError, OSError):  # closed by stop_server
-            return
-
-    threading.Thread(target=pump, daemon=True).start()
+    server = spawn("the server", command, env_extra, f"http://127.0.0.1:{port}")
     try:
         wait_until_up(server)
     except BaseException:  # Ctrl-C included: never leave a server behind
-        stop_server(server)
+        stop(server)
         raise
     return server
 
 
-def wait_until_up(server: Server) -> None:
-    deadline = time.monotonic() + SERVER_START_TIMEOUT_S
-    while time.monotonic() < deadline:
-        if server.process.poll() is not None:
-            raise BenchError("the server exited at start:\n" + server.tail())
-        try:
-            if httpx.get(f"{server.url}/api/health", timeout=1.0).status_code == 200:
-                break
-        except httpx.TransportError:
-            pass
-        time.sleep(0.1)
-    else:
-        raise BenchError(
-            f"the server did not answer in {SERVER_START_TIMEOUT_S:g} s:\n" + server.tail()
-        )
-    time.sleep(0.2)  # the login line is printed before uvicorn answers; let the pump read it
-    if not server.admin_token:
-        raise BenchError("the server printed no instructor login URL:\n" + server.tail())
-
-
-def stop_server(server: Server, timeout_s: float = 30.0) -> None:
-    """SIGTERM (uvicorn stops every run, then the sandboxes), SIGKILL if that hangs."""
-    if server.process.poll() is None:
-        server.process.terminate()
-        try:
-            server.process.wait(timeout_s)
-        except subprocess.TimeoutExpired:
-            print(f"bench_api: the server did not stop in {timeout_s:g} s; killing it")
-            server.process.kill()
-            server.process.wait()
-    if server.process.stdout is not None:
-        server.process.stdout.close()
-
-
 # ------------------------------------------------------------------------------------ measuring
-def bearer(token: str) -> dict[str, str]:
-    return {"Authorization": f"Bearer {token}"}
-
-
-@dataclass
-class Window:
-    """The measurement interval [start, end) in time.monotonic() seconds; inf until known."""
-
-    start: float = math.inf
-    end: float = math.inf
-
-    def __contains__(self, moment: float) -> bool:
-        return self.start <= moment < self.end
-
-
 @dataclass
 class ViewerStats:
     settled: asyncio.Event = field(default_factory=asyncio.Event)  # subscribed, or gave up
@@ -333,58 +259,6 @@ async def watch(
         stats.settled.set()
 
 
-@dataclass
-class HttpStats:
-    latencies_s: array = field(default_factory=lambda: array("d"))
-    errors: collections.Counter = field(default_factory=collections.Counter)
-    skipped: int = 0  # not sent: MAX_HTTP_IN_FLIGHT requests were already waiting
-
-
-async def poll_status(
-    client: httpx.AsyncClient,
-    runs: list[tuple[str, str]],
-    rate_hz: float,
-    window: Window,
-    stats: HttpStats,
-) -> None:
-    """GET /api/runs/{id} round robin over the runs at a fixed schedule (open loop), until
-    the window ends; then waits for the requests still out, so slow answers are counted."""
-
-    async def one(run_id: str, token: str) -> None:
-        sent = time.monotonic()
-        try:
-            answer = await client.get(f"/api/runs/{run_id}", headers=bearer(token))
-            outcome = answer.status_code
-        except httpx.HTTPError as error:
-            outcome = type(error).__name__
-        if sent in window:
-            if outcome == 200:
-                stats.latencies_s.append(time.monotonic() - sent)
-            else:
-                stats.errors[outcome] += 1
-
-    pending: set[asyncio.Task] = set()
-    next_at = time.monotonic()
-    try:
-        for k in itertools.count():
-            next_at += 1.0 / rate_hz
-            await asyncio.sleep(max(0.0, next_at - time.monotonic()))
-            if next_at >= window.end:
-                break
-            if len(pending) >= MAX_HTTP_IN_FLIGHT:
-                if next_at in window:
-                    stats.skipped += 1
-                continue
-            task = asyncio.create_task(one(*runs[k % len(runs)]))
-            pending.add(task)
-            task.add_done_callback(pending.discard)
-        if pending:
-            await asyncio.wait(pending, timeout=HTTP_TIMEOUT_S + 1.0)
-    finally:
-        for task in pending:
-            task.cancel()
-
-
 async def collect_server_latencies(
     client: httpx.AsyncClient, admin: dict, window: Window, into: array
 ) -> None:
@@ -414,43 +288,6 @@ async def memory_growth(client: httpx.AsyncClient, admin: dict, reset: bool = Fa
     )
     answer.raise_for_status()
     return answer.json()["top"]
-
-
-async def loop_lag(into: array, window: Window) -> None:
-    """How late this client's own event loop wakes: its share of every latency above."""
-    while True:
-        due = time.monotonic() + LOOP_TICK_S
-        await asyncio.sleep(LOOP_TICK_S)
-        now = time.monotonic()
-        if now in window:
-            into.append(now - due)
-
-
-@dataclass
-class MemorySample:
-    at_s: float
-    server_rss: int  # [B]
-    sandboxes_rss: int  # [B] every process below the server
-
-
-def sample_memory(process: psutil.Process) -> MemorySample:
-    children = 0
-    for child in process.children(recursive=True):
-        try:
-            children += child.memory_info().rss
-        except psutil.Error:
-            continue
-    return MemorySample(time.monotonic(), process.memory_info().rss, children)
-
-
-async def sample_memory_every(
-    process: psutil.Process, every_s: float, into: list[MemorySample], window: Window
-) -> None:
-    while True:
-        sample = sample_memory(process)
-        if sample.at_s in window:
-            into.append(sample)
-        await asyncio.sleep(every_s)
 
 
 # ------------------------------------------------------------------------------------- the load
@@ -513,7 +350,7 @@ class Results:
     heap_growth: list[dict]  # --tracemalloc: {where, kib, blocks}, biggest growth first
 
 
-async def load(server: Server, args: argparse.Namespace, run_duration_s: float) -> Results:
+async def load(server: LabProcess, args: argparse.Namespace, run_duration_s: float) -> Results:
     admin = bearer(server.admin_token)
     limits = httpx.Limits(max_connections=MAX_HTTP_IN_FLIGHT + 4)
     async with httpx.AsyncClient(
@@ -534,7 +371,7 @@ async def load(server: Server, args: argparse.Namespace, run_duration_s: float) 
 
 
 async def measure(
-    server: Server,
+    server: LabProcess,
     client: httpx.AsyncClient,
     admin: dict,
     runs: list[tuple[str, str]],
@@ -562,7 +399,9 @@ async def measure(
     http, server_latencies, loop_lags = HttpStats(), array("d"), array("d")
     memory: list[MemorySample] = []
     process, me = psutil.Process(server.process.pid), psutil.Process()
-    poller = asyncio.create_task(poll_status(client, runs, args.http_rate, window, http))
+    poller = asyncio.create_task(
+        poll_status([(client, *run) for run in runs], args.http_rate, window, http)
+    )
     tasks += [
         poller,
         asyncio.create_task(loop_lag(loop_lags, window)),
@@ -628,31 +467,6 @@ async def measure(
 
 
 # ------------------------------------------------------------------------------------ reporting
-def percentile(values, q: float) -> float:
-    ordered = sorted(values)
-    return ordered[min(len(ordered) - 1, round(q * (len(ordered) - 1)))]
-
-
-def p99_ms(seconds) -> float:
-    return percentile(seconds, 0.99) * 1e3 if len(seconds) else math.nan
-
-
-def row(label: str, seconds, note: str = "") -> None:
-    if not len(seconds):
-        print(f"{label:<58} {'n/a':>8}   {note}")
-        return
-    ordered = sorted(seconds)
-    p50, p99 = percentile(ordered, 0.5) * 1e3, percentile(ordered, 0.99) * 1e3
-    print(f"{label:<58} {p50:8.1f} {p99:8.1f} {ordered[-1] * 1e3:8.1f} {len(ordered):9d}   {note}")
-
-
-def slope(minutes: list[float], mib: list[float]) -> float:
-    """Least-squares growth [MiB/min]; nan with fewer than two samples."""
-    if len(minutes) < 2:
-        return math.nan
-    return statistics.linear_regression(minutes, mib).slope
-
-
 def report(results: Results, args: argparse.Namespace, source_hz: float) -> None:
     viewers = results.viewers
     window_s = results.window_s
@@ -756,7 +570,7 @@ def main() -> None:
         "ROBODOJO_MAX_RUN_DURATION_S": str(math.ceil(run_duration_s)),
     }
     # SIGTERM ends the benchmark as Ctrl-C does: through the finally that stops the server.
-    signal.signal(signal.SIGTERM, _interrupt)
+    stop_on_sigterm()
     print(f"machine before: load average {os.getloadavg()[0]:.1f}, {psutil.cpu_count()} CPUs")
     with tempfile.TemporaryDirectory(prefix="robodojo-bench-api-") as data:
         server = None
@@ -772,12 +586,8 @@ def main() -> None:
             raise SystemExit(1) from None
         finally:
             if server is not None:
-                stop_server(server)
+                stop(server)
     report(results, args, source_hz)
-
-
-def _interrupt(signum: int, frame) -> None:
-    raise KeyboardInterrupt
 
 
 if __name__ == "__main__":

@@ -9,7 +9,13 @@ Prints
 - memory per run: resident memory of a node's sandbox (proportional set size, shared libraries
   split fairly) and what the server process grew by per run.
 
+With --workers N (issue 16) the realtime runs go through the lab's run service and executor
+instead, as `robodojo serve --workers N` runs them: N worker processes (one per core is the
+default), or 0 for the web process's own threads; it prints each rate's worst whole-run p99 and
+the worst p99 of each run's newest loop periods read live near its end (steady).
+
 Usage: python bench/bench_runs.py [--repeats 5] [--concurrent 20] [--rates 20,50,100]
+       python bench/bench_runs.py --workers 2 --rates 100     (and --workers 0 to compare)
 Targets (issue 4): the 60 s lockstep run in under 2 s; 20 realtime runs at 100 Hz with period
 p99 under 11 ms on this 2-core machine.
 """
@@ -23,6 +29,8 @@ import tempfile
 import threading
 import time
 from pathlib import Path
+
+from _common import percentile
 
 from sandbox.launcher import Launcher
 from sandbox.protocol import Clock
@@ -44,11 +52,6 @@ def step(obs):
 def spec(rate_hz: float, duration_s: float, clock: Clock) -> RunSpec:
     node = NodeSpec("controller", CONTROLLER.format(rate=rate_hz), "controller.py")
     return RunSpec("crowbot", "wall_approach", (node,), clock=clock, duration_s=duration_s)
-
-
-def percentile(values: list[float], q: float) -> float:
-    ordered = sorted(values)
-    return ordered[min(len(ordered) - 1, round(q * (len(ordered) - 1)))]
 
 
 def wait_for_pool(launcher: Launcher, count: int) -> None:
@@ -152,15 +155,91 @@ def bench_concurrent(rate_hz: float, count: int, duration_s: float, out: Path) -
     return ok, memory
 
 
+def bench_executor(
+    rate_hz: float, count: int, duration_s: float, out: Path, workers: int
+) -> tuple[bool, float, float]:
+    """`count` realtime runs through RunService and the executor `workers` chooses; (ok, worst
+    steady p99, worst whole-run p99) [s]."""
+    from server.api.settings import Settings
+    from server.service.runs import RunRequest, RunService
+    from server.store import accounts
+    from server.store import runs as run_store
+    from server.store.db import Store
+
+    per_process = count if workers == 0 else -(-count // workers)
+    settings = Settings(
+        data=out / f"lab-{workers}-{rate_hz:g}",
+        workers=workers,
+        max_runs_total=count,
+        max_runs_per_student=count,
+        sandbox_pool=per_process,
+        rosserial_port=-1,
+    )
+    settings.data.mkdir(parents=True)
+    store = Store.open(settings.store_url)
+    launcher = Launcher(pool_size=count if workers == 0 else 0)
+    service = RunService(store, settings, launcher)
+    if workers == 0:
+        wait_for_pool(launcher, count)
+    else:
+        assert service.executor.wait_ready(timeout_s=300.0, warm=True), "workers not warm"
+    node = NodeSpec("controller", CONTROLLER.format(rate=rate_hz), "controller.py")
+    request = RunRequest("crowbot", "wall_approach", None, (node,), Clock.REALTIME, duration_s, 0)
+    with store.session() as db:
+        user_id = accounts.create_user(db, "bench", accounts.Role.STUDENT).user.id
+    run_ids = [service.start(user_id, request).id for _ in range(count)]
+    time.sleep(duration_s * 0.9)
+    steady = []
+    for run_id in run_ids:  # the newest loop periods, read live as the page reads them
+        live = service.live(run_id)
+        recent = live.node_periods.get("controller", {}) if live is not None else {}
+        if recent.get("p99_s") is not None:
+            steady.append(recent["p99_s"])
+    deadline = time.monotonic() + duration_s + 60.0
+    while any(service.is_running(run_id) for run_id in run_ids) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    with store.session() as db:
+        records = [run_store.get(db, run_id) for run_id in run_ids]
+        failed = [r.reason for r in records if r.state != str(RunState.FINISHED)]
+        whole = [r.nodes["controller"]["period"]["p99_s"] for r in records if r.nodes]
+    service.shutdown()
+    launcher.close()
+    store.close()
+    period_s = 1.0 / rate_hz
+    worst_steady = max(steady) if steady else float("nan")
+    worst_whole = max(whole) if whole else float("nan")
+    ok = not failed and worst_steady <= 1.1 * period_s
+    mode = "in the web process" if workers == 0 else f"on {workers} worker processes"
+    print(
+        f"{count} realtime runs at {rate_hz:g} Hz {mode} (limit {1.1 * period_s * 1e3:.1f} ms): "
+        f"steady p99 worst {worst_steady * 1e3:.2f} ms, median "
+        f"{statistics.median(steady) * 1e3 if steady else float('nan'):.2f} ms; whole-run p99 "
+        f"worst {worst_whole * 1e3:.2f} ms, median "
+        f"{statistics.median(whole) * 1e3 if whole else float('nan'):.2f} ms"
+        f"{'  FAILED: ' + failed[0] if failed else ''}  -> {'ok' if ok else 'over'}"
+    )
+    return ok, worst_steady, worst_whole
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--concurrent", type=int, default=20)
     parser.add_argument("--rates", default="20,50,100")
     parser.add_argument("--duration", type=float, default=10.0, help="realtime run length [s]")
+    parser.add_argument(
+        "--workers",
+        type=int,
+        default=None,
+        help="realtime runs through the run service on N worker processes (0: in its threads)",
+    )
     args = parser.parse_args()
     with tempfile.TemporaryDirectory(prefix="robodojo-bench-") as tmp:
         out = Path(tmp)
+        if args.workers is not None:
+            for rate in (float(r) for r in args.rates.split(",")):
+                bench_executor(rate, args.concurrent, args.duration, out, args.workers)
+            return
         bench_lockstep(args.repeats, out)
         best = None
         memory = None

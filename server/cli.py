@@ -11,6 +11,7 @@
                  --args "--ros-args -p speed:=0.2 -r cmd_vel:=Control"   # a ROS 2 node's argv
     robodojo export RUN_DIR               # a CSV per topic from a run's recording
     robodojo serve                        # the web lab (server/api/serve.py)
+    robodojo worker --redis-url URL --database-url URL   # a cluster's worker (server/workers)
 
 `run` executes headless: a progress bar of simulated time on a terminal (plain lines when not a
 TTY), the recording and artifacts written to --out, and one JSON summary as the last line of
@@ -46,7 +47,7 @@ from server.runs.spec import NodeSpec, RunSpec, RunSpecError
 from server.runs.state import RunState
 from server.sim import get_robot, load_world, robot_ids, robots_for_world, world_ids
 from server.sim.world import WorldError
-from server.store.db import StoreError
+from server.store.errors import StoreError
 
 PROGRESS_WIDTH = 30  # [characters] of the progress bar
 
@@ -231,16 +232,14 @@ def _cmd_check(args: argparse.Namespace) -> int:
         nodes = starter_nodes(exercise)
     else:
         nodes = _node_specs(args.node)
-    # Every seed's nodes start together, warm, while the first run is being set up.
-    launcher = Launcher(
-        pool_size=len(nodes) * max(len(exercise.seeds), len(exercise.starts)),
-        unsafe_no_sandbox=args.unsafe_no_sandbox,
-    )
+    # Each seed's run in a worker process forked from this one, with its own launcher.
+    clock = Clock(args.clock) if args.clock else None
+    out_dir = Path(args.out) if args.out else None
     try:
-        clock = Clock(args.clock) if args.clock else None
-        result = grade(exercise, nodes, launcher, Path(args.out) if args.out else None, clock)
-    finally:
-        launcher.close()
+        result = grade(exercise, nodes, None, out_dir, clock, args.unsafe_no_sandbox)
+    except KeyboardInterrupt:  # Ctrl-C reaches the workers too: their runs end with them
+        print("robodojo: check interrupted from the keyboard; no grade", file=sys.stderr)
+        return 1
     for run in result.runs:
         if run["state"] != RunState.FINISHED:
             print(f"seed {run['seed']}: {run['reason']}", file=sys.stderr)
@@ -359,6 +358,9 @@ def build_parser() -> argparse.ArgumentParser:
     from server.api.serve import add_commands
 
     add_commands(commands)
+    from server.workers.cli import add_command as add_worker_command
+
+    add_worker_command(commands)
     return parser
 
 

@@ -55,6 +55,11 @@ def wheel_names(tmp_path_factory: pytest.TempPathFactory) -> set[str]:
 def test_the_wheel_carries_the_pages_the_server_serves(wheel_names: set[str]) -> None:
     missing = [name for name in WEB_FILES if f"server/web_assets/{name}" not in wheel_names]
     assert missing == []
+    # The built guide (/guide/), every file of it: pages, figures, search index, theme assets.
+    guide = [p.relative_to(ROOT / "web").as_posix() for p in (ROOT / "web" / "guide").rglob("*")
+             if p.is_file()]  # fmt: skip
+    assert len(guide) > 50
+    assert [n for n in guide if f"server/web_assets/{n}" not in wheel_names] == []
     assert not any(name.startswith("server/web_assets/src/") for name in wheel_names)
 
 

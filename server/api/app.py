@@ -28,7 +28,9 @@ from server.api.routes import (
     admin_robots,
     admin_runs,
     catalog,
+    checks,
     comparison,
+    editor,
     hardware,
     leaderboards,
     live,
@@ -39,13 +41,14 @@ from server.api.routes import (
 )
 from server.api.settings import Settings
 from server.api.sockets import OpenSockets
+from server.editor.service import EditorService
 from server.service import disk
-from server.service.hardware import HardwareHub
 from server.service.runs import RunService
 from server.store import accounts
 from server.store import runs as run_store
 from server.store.accounts import Role
 from server.store.db import Store
+from server.workers.remote_bench import bench_for
 
 log = logging.getLogger("robodojo.api")
 # web/ through the server/web_assets link, so a wheel carries the pages inside the package.
@@ -79,22 +82,29 @@ def create_app(settings: Settings | None = None, launcher: Launcher | None = Non
     async def lifespan(app: FastAPI):
         settings.data.mkdir(parents=True, exist_ok=True)
         store = Store.open(settings.store_url)
-        with store.session() as db:
-            interrupted = run_store.mark_interrupted(db)
-        if interrupted:
-            log.warning("%d run(s) were active when the server stopped: marked interrupted",
-                        interrupted)  # fmt: skip
+        if not settings.redis_url:  # a cluster's runs live on its workers, not in this process
+            with store.session() as db:
+                interrupted = run_store.mark_interrupted(db)
+            if interrupted:
+                log.warning("%d run(s) were active when the server stopped: marked interrupted",
+                            interrupted)  # fmt: skip
         own_launcher = launcher is None
         run_launcher = launcher or Launcher(
             pool_size=settings.sandbox_pool, unsafe_no_sandbox=settings.unsafe_no_sandbox
         )
         app.state.settings = settings
         app.state.store = store
-        app.state.hardware = HardwareHub(store, settings)
+        app.state.hardware = bench_for(store, settings)  # RemoteBench in a cluster
         app.state.hardware.start()
         # The service listens to the hub (a run past its robot's slot is stopped); the hub
         # knows no service.
         app.state.runs = RunService(store, settings, run_launcher, app.state.hardware)
+        # The editor's analysis workers start and warm up in the background (seconds).
+        app.state.editor = EditorService(
+            settings.max_code_bytes_per_file, settings.editor_workers,
+            settings.data / "cache" / "editor",
+        )  # fmt: skip
+        app.state.editor.start()
         url = bootstrap(store, settings)
         if url:
             print(f"RoboDojo: log in as the instructor at {url}", flush=True)
@@ -111,6 +121,7 @@ def create_app(settings: Settings | None = None, launcher: Launcher | None = Non
             with contextlib.suppress(asyncio.CancelledError):
                 await sweeper
             app.state.runs.shutdown()  # robots commanded to zero as their runs end
+            app.state.editor.close()
             app.state.hardware.stop()
             if own_launcher:
                 run_launcher.close()
@@ -144,9 +155,9 @@ def create_app(settings: Settings | None = None, launcher: Launcher | None = Non
     app.add_middleware(BodyLimit, max_bytes=settings.max_request_body_bytes)
     app.add_middleware(SecurityHeaders)
 
-    for module in (session, catalog, workspaces, runs, comparison, live, admin, admin_runs,
+    for module in (session, catalog, workspaces, runs, checks, comparison, live, admin, admin_runs,
                    admin_courses, admin_exercises, admin_robots, hardware, viz,
-                   leaderboards):  # fmt: skip
+                   leaderboards, editor):  # fmt: skip
         app.include_router(module.router)
 
     def page(name: str):
@@ -167,4 +178,11 @@ def create_app(settings: Settings | None = None, launcher: Launcher | None = Non
         return page("admin.html")
 
     app.mount("/static", StaticFiles(directory=WEB_DIR / "static", check_dir=False), name="static")
+    # The guide (docs/ built by `python3 -m guide.build` into web/guide/, committed and shipped
+    # in the wheel like the bundles): public, as a course's handout is.
+    app.mount(
+        "/guide",
+        StaticFiles(directory=WEB_DIR / "guide", html=True, check_dir=False),
+        name="guide",
+    )
     return app

@@ -20,6 +20,7 @@ from server.service.disk import DiskBudgetError
 from server.service.exercises import ExerciseDefinitionError
 from server.service.runs import RunLimitError, RunRequestError
 from server.service.workspace_files import WorkspaceFileError
+from server.workers.remote_bench import BenchUnavailableError
 
 log = logging.getLogger("robodojo.api")
 
@@ -60,6 +61,12 @@ async def _run_limit(_: Request, error: RunLimitError) -> JSONResponse:
         content={"detail": str(error), "retry_after_s": error.retry_after_s},
         headers={"Retry-After": str(error.retry_after_s)},
     )
+
+
+async def _bench_away(_: Request, error: BenchUnavailableError) -> JSONResponse:
+    # 503: the robots' bench worker (or Redis) is away; trying again later may work.
+    headers = {"Retry-After": "5"}
+    return JSONResponse(status_code=503, content={"detail": str(error)}, headers=headers)
 
 
 async def _disk_budget(_: Request, error: DiskBudgetError) -> JSONResponse:
@@ -151,6 +158,7 @@ def install(app: FastAPI) -> None:
     app.add_exception_handler(UnknownIdError, _unknown_id)
     app.add_exception_handler(RunLimitError, _run_limit)
     app.add_exception_handler(DiskBudgetError, _disk_budget)
+    app.add_exception_handler(BenchUnavailableError, _bench_away)
     app.add_exception_handler(RunRequestError, _bad_run)
     app.add_exception_handler(RunSpecError, _bad_run)
     app.add_exception_handler(WorkspaceFileError, _bad_file)

@@ -130,6 +130,13 @@ class RunCreate(Strict):
     clock: Literal["lockstep", "realtime"] | None = None
     duration: float | None = Field(None, gt=0, le=86400, description="[s] of robot time")
     seed: int | None = Field(None, ge=0, le=2**31 - 1)
+    case: int | None = Field(
+        None,
+        ge=0,
+        le=63,
+        description="an exercise's grading case (0, 1, ...): its seed and start pose, as "
+        "`robodojo check` runs them; GET /api/exercises/{id}/check sums up a set of them",
+    )
     teleop: bool = Field(False, description="drive with the arrow keys (adds the teleop node)")
     hardware: str | None = Field(
         None, pattern=r"^[a-z][a-z0-9_\-]{0,63}$", description="run on this robot of the bench"

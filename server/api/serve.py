@@ -2,6 +2,7 @@
 
     robodojo serve                                  # http://127.0.0.1:8000, data in ./robodojo-data
     robodojo serve --port 9000 --database-url postgresql://lab@db/robodojo
+    robodojo serve --redis-url redis://queue:6379/0 --database-url postgresql://...  # cluster
     robodojo login-url                              # a new login link for the first instructor
 
 Options override the ROBODOJO_* environment variables, which override the defaults (Settings).
@@ -11,13 +12,18 @@ from __future__ import annotations
 
 import argparse
 import logging
+from typing import TYPE_CHECKING
 
-from server.api.settings import Settings
+if TYPE_CHECKING:
+    from server.api.settings import Settings
 
 
 def _settings(args: argparse.Namespace) -> Settings:
+    # Imported here: pydantic-settings costs ~0.1 s, and `robodojo run` builds this parser too.
+    from server.api.settings import Settings
+
     overrides = {}
-    keys = ("host", "port", "data", "database_url", "public_url")
+    keys = ("host", "port", "data", "database_url", "public_url", "redis_url", "workers")
     for key in (*keys, "rosserial_port", "rosserial_host"):
         value = getattr(args, key, None)
         if value is not None:
@@ -34,6 +40,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
     from server.api.app import create_app
     from server.api.http_server import h11_with_header_timeout, install_redaction
     from server.store.db import Store
+    from server.workers.choose import local_worker_count
 
     settings = _settings(args)
     logging.basicConfig(level=logging.INFO, format="%(levelname)s %(name)s: %(message)s")
@@ -41,8 +48,12 @@ def cmd_serve(args: argparse.Namespace) -> int:
     logging.getLogger("alembic.runtime.plugins").setLevel(logging.WARNING)
     # Fail before uvicorn starts, with our sentence, when the database or sandbox cannot work.
     Store.open(settings.store_url).close()
+    # A web process whose runs execute on worker processes keeps no warm sandbox waiting for
+    # one (a real robot's run, the one kind it executes itself, starts cold).
+    runs_here = not settings.redis_url and local_worker_count(settings) == 0
     launcher = Launcher(
-        pool_size=settings.sandbox_pool, unsafe_no_sandbox=settings.unsafe_no_sandbox
+        pool_size=settings.sandbox_pool if runs_here else 0,
+        unsafe_no_sandbox=settings.unsafe_no_sandbox,
     )
     try:
         config = uvicorn.Config(
@@ -104,6 +115,19 @@ def _common(parser: argparse.ArgumentParser) -> None:
 def add_commands(commands) -> None:
     serve = commands.add_parser("serve", help="start the web lab (API, websockets, pages)")
     _common(serve)
+    serve.add_argument(
+        "--redis-url",
+        default=None,
+        help="redis://host:6379/0: queue runs for `robodojo worker` processes (a cluster) "
+        "instead of running them here",
+    )
+    serve.add_argument(
+        "--workers",
+        type=int,
+        default=None,
+        help="worker processes that execute runs on this machine (default: one per core; "
+        "0: in the web process itself)",
+    )
     serve.add_argument(
         "--rosserial-port",
         type=int,

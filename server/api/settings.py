@@ -24,6 +24,17 @@ class Settings(BaseSettings):
     # How browsers reach us (behind a proxy): printed links, and an origin the CSRF and websocket
     # Origin checks accept besides the one a request came to (auth.py).
     public_url: str | None = None
+    # The cluster (issue 16): with a Redis URL the web process queues runs for `robodojo worker`
+    # processes (any machine; same database and data volume) and runs none itself.
+    redis_url: str | None = None
+    worker_processes: int = Field(0, ge=0)  # `robodojo worker`: processes; 0 = one per core
+    runs_per_process: int = Field(12, ge=1)  # runs one worker process takes at once (two cores
+    # of a default worker hold the lab's default max_runs_total of 24)
+
+    # The embedded lab (no Redis) runs its runs on worker processes of this machine, one per
+    # core by default: twenty realtime runs in one interpreter miss their periods. 0 = in the web
+    # process's own threads (tests, a tiny machine); runs on a real robot always stay there.
+    workers: int | None = Field(None, ge=0)  # None = os.cpu_count()
 
     # Limits that protect the lab: value and why.
     max_runs_per_student: int = Field(2, ge=1)  # two: one running, one being looked at
@@ -70,6 +81,10 @@ class Settings(BaseSettings):
     header_timeout_s: float = Field(10.0, gt=0)  # [s] request line and headers must be in by then
     keep_alive_timeout_s: int = Field(5, ge=1)  # [s] idle between requests (uvicorn's default)
     max_header_bytes: int = Field(32 * KIB, ge=1024)  # [B] request line + headers (h11: 16 KiB)
+
+    # The editor's analysis (server/editor): worker processes for completion and our checks,
+    # ~150 MiB each; 0 turns the editor's help off (its routes say so).
+    editor_workers: int = Field(2, ge=0, le=16)
 
     unsafe_no_sandbox: bool = False  # trusted machines only: student code runs unconfined
     sandbox_pool: int = Field(2, ge=0)  # warm sandbox processes kept ready

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from server.exercises.checks import collisions
 from server.exercises.evidence import Evidence
 from server.exercises.model import Check, Comparison, Exercise
 
@@ -109,7 +110,7 @@ CROP_ROW_FUZZY = Exercise(
             "",
             Comparison.AT_MOST,
             0,
-            lambda evidence: float(evidence.result.metrics["collisions"]),
+            collisions,
         ),
     ),
 )

@@ -7,12 +7,14 @@ import math
 import tempfile
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 
 from sandbox.launcher import Launcher
 from sandbox.protocol import Clock
 from server.exercises.evidence import load_evidence
 from server.exercises.model import Exercise
+from server.exercises.parallel_runs import run_in_processes
 from server.runs.result import RunResult
 from server.runs.run import Run
 from server.runs.spec import NodeSpec, RunSpec
@@ -142,42 +144,75 @@ def judge_run(exercise: Exercise, result: RunResult, run_dir: Path) -> tuple[lis
     return checks, score
 
 
-def grade(
-    exercise: Exercise,
-    nodes: tuple[NodeSpec, ...],
-    launcher: Launcher,
-    out_dir: Path | None = None,
-    clock: Clock | None = None,
-) -> Grade:
-    root = Path(out_dir) if out_dir else Path(tempfile.mkdtemp(prefix=f"check-{exercise.id}-"))
+@dataclass(frozen=True, slots=True)
+class Case:
+    """One graded run: its index among the check's runs, its seed and its start pose (None: the
+    exercise's own)."""
 
-    def one_run(case: tuple[int, int, tuple[float, float, float] | None]):
-        index, seed, start = case
-        run_dir = root / f"run{index}-seed{seed}"
-        result = Run(run_spec(exercise, nodes, seed, start, clock), launcher, run_dir).execute()
-        values = check_values(exercise, result, run_dir)
-        summary = {
-            "seed": seed,
-            "start": list(start) if start else None,
-            "state": str(result.state),
-            "reason": result.reason,
-            "run_dir": str(run_dir),
-        }
-        return summary, values
+    index: int
+    seed: int
+    start: tuple[float, float, float] | None
 
-    # One run per seed, or per start pose (seeds taken in turn); independent runs go side by
-    # side (their nodes are separate processes).
+
+def cases_of(exercise: Exercise) -> list[Case]:
+    """One run per seed, or per start pose (seeds taken in turn)."""
     seeds = exercise.seeds
     if exercise.starts:
         count = max(len(exercise.starts), len(seeds))
-        cases = [
-            (i, seeds[i % len(seeds)], exercise.starts[i % len(exercise.starts)])
+        return [
+            Case(i, seeds[i % len(seeds)], exercise.starts[i % len(exercise.starts)])
             for i in range(count)
         ]
+    return [Case(i, seed, None) for i, seed in enumerate(seeds)]
+
+
+def run_case(
+    exercise: Exercise,
+    nodes: tuple[NodeSpec, ...],
+    root: Path,
+    clock: Clock | None,
+    case: Case,
+    launcher: Launcher,
+) -> tuple[dict, dict[str, float]]:
+    """One case run and judged: its summary and each check's value (picklable: a worker
+    process sends them back)."""
+    run_dir = root / f"run{case.index}-seed{case.seed}"
+    spec = run_spec(exercise, nodes, case.seed, case.start, clock)
+    result = Run(spec, launcher, run_dir).execute()
+    values = check_values(exercise, result, run_dir)
+    summary = {
+        "seed": case.seed,
+        "start": list(case.start) if case.start else None,
+        "state": str(result.state),
+        "reason": result.reason,
+        "run_dir": str(run_dir),
+    }
+    return summary, values
+
+
+def grade(
+    exercise: Exercise,
+    nodes: tuple[NodeSpec, ...],
+    launcher: Launcher | None,
+    out_dir: Path | None = None,
+    clock: Clock | None = None,
+    unsafe_no_sandbox: bool = False,
+) -> Grade:
+    """Run every case of the exercise and judge each check by its worst case.
+
+    `launcher`: None runs each case in a worker process of its own, with its own launcher
+    (server/exercises/parallel_runs.py: what `robodojo check` does; `unsafe_no_sandbox` is for
+    those launchers). A launcher runs the cases in threads of this process with it (tests that
+    share one warm pool): the same values, more slowly, as the runs' loops share one GIL."""
+    root = Path(out_dir) if out_dir else Path(tempfile.mkdtemp(prefix=f"check-{exercise.id}-"))
+    cases = cases_of(exercise)
+    job = partial(run_case, exercise, nodes, root, clock)
+    if launcher is None:
+        outcomes = run_in_processes(job, cases, unsafe_no_sandbox)
     else:
-        cases = [(i, seed, None) for i, seed in enumerate(seeds)]
-    with ThreadPoolExecutor(max_workers=len(cases)) as pool:
-        outcomes = list(pool.map(one_run, cases))
+        # Independent runs go side by side (their nodes are separate processes).
+        with ThreadPoolExecutor(max_workers=len(cases)) as pool:
+            outcomes = list(pool.map(lambda case: job(case, launcher), cases))
     runs = [summary for summary, _ in outcomes]
     per_check = {c.name: [values[c.name] for _, values in outcomes] for c in exercise.checks}
     results = tuple(

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import pickle
+
 from server.exercises.crop_rover import EXERCISES as CROP_ROVER
 from server.exercises.crowbot import EXERCISES as CROWBOT
 from server.exercises.ir_scout import EXERCISES as IR_SCOUT
@@ -55,6 +57,13 @@ def validate_exercise(exercise: Exercise) -> list[str]:
         problems.append(
             f"{where}: leaderboard_check '{exercise.leaderboard_check}' is none of its checks "
             f"({', '.join(names)})"
+        )
+    try:
+        pickle.dumps(exercise)  # `robodojo check` sends it to its worker processes
+    except (pickle.PicklingError, TypeError, AttributeError) as error:
+        problems.append(
+            f"{where}: cannot be sent to a grading worker process (each check's metric must be "
+            f"a module-level function, not a lambda or a closure): {error}"
         )
     for label, files in (("reference", exercise.reference), ("starter", exercise.starter)):
         if not files:

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from server.exercises.grading import cases_of
 from server.exercises.model import Exercise
 from server.exercises.registry import exercise_ids, get_exercise
 from server.sim import get_robot, load_world, robot_ids, robots_for_world, world_ids
@@ -136,6 +137,12 @@ def describe(entry: ExerciseEntry) -> dict:
         "clock": str(exercise.clock),
         "custom": entry.custom,
         "builtin_nodes": list(exercise.builtin_nodes),
+        # Its grading cases (seed, start pose), as `robodojo check` runs them: the page's
+        # "Check all seeds" starts one run per case (POST /api/runs with `case`).
+        "cases": [
+            {"case": case.index, "seed": case.seed, "start": list(case.start or []) or None}
+            for case in cases_of(exercise)
+        ],
         # What its leaderboards rank equal scores by (None: by who got there first).
         "leaderboard_check": key.name if (key := exercise.key_check()) else None,
         "starter": [

@@ -261,6 +261,12 @@ class HardwareHub(RosserialHandler):
                 old.close()
         return link
 
+    def robots(self) -> list[str]:
+        """The robots this hub knows now: connected, or with a queue (a bench worker publishes
+        their health, server/workers/bench.py)."""
+        with self._lock:
+            return sorted(set(self._links) | set(self._queues))
+
     def queue(self, name: str) -> RobotQueue:
         with self._lock:
             queue = self._queues.get(name)

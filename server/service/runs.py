@@ -1,48 +1,47 @@
-"""The run service: starts runs for users, enforces the lab's limits, keeps the store up to date
-as runs change state, judges exercise runs when they end, and stops everything cleanly at
-shutdown. It knows nothing of HTTP: the API calls it, the CLI could too.
+"""The run service: starts runs for users, enforces the lab's limits, and is the one door to a
+running run. It knows nothing of HTTP: the API calls it, the CLI could too.
 
-Runs execute in-process, each `Run.execute()` on a worker thread of one pool (the executor seam:
-a distributed worker would replace `_submit`). A run's crash ends that run only: `execute()`
-never raises for what a node does, and anything else is caught here and stored as the reason.
+A run is stored as "created" and handed as a `RunJob` to an executor (server/workers): in this
+process's threads, on worker processes of this machine, or on a cluster's workers. Wherever it
+runs, a `RunHost` there stores its state changes and its end, judges it, and sends its live
+traffic back; this service reads it only through the executor, as data.
 
-This is the one door to a running run: routes, the websocket, the 3D view and the hardware hub
-tell it things with typed commands (`command(run_id, Stop(...))`, server/runs/commands.py) and
-read it through plain snapshots (`live`, `logs`, `graph`, `lights`, `feed`); none of them holds
-the `Run`. What crosses this door is data, so a run on another process could stand behind it.
+Routes, the websocket, the 3D view and the hardware hub tell a run things with typed commands
+(`command(run_id, Stop(...))`, server/runs/commands.py) and read it through plain snapshots
+(`live`, `logs`, `graph`, `lights`, `feed`); none of them holds the `Run`. The limits count the
+DATABASE's active runs, so every web process of a lab agrees on them.
 """
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import logging
 import threading
 import time
 import uuid
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from sandbox.launcher import Launcher
 from sandbox.protocol import Clock
-from server.exercises.grading import judge_run, run_spec
-from server.hardware.backend import HardwareRobot
+from server.exercises.grading import cases_of, run_spec
 from server.hardware.queue import QueueError
-from server.hardware.safety import MotionLimits
-from server.runs.commands import RunCommand, Stop
-from server.runs.recorder import json_safe
-from server.runs.result import RunResult
-from server.runs.run import Run
+from server.runs.commands import CommandError, RunCommand, Stop
 from server.runs.spec import NodeSpec, RunSpec
 from server.runs.state import RunState
 from server.service import disk
 from server.service.catalog import ExerciseEntry
-from server.service.telemetry import RunTelemetry, TelemetryRegistry
+from server.service.telemetry import RunTelemetry
 from server.sim.world import LightSource
 from server.store import robots as inventory
 from server.store import runs as run_store
 from server.store.db import Store
 from server.store.models import RunRecord
+from server.store.runs import RunFilter
+from server.workers.choose import make_executor
+from server.workers.seams import ExecutorUnavailableError
+from server.workers.wire import RunJob
 
 log = logging.getLogger("robodojo.service")
 
@@ -73,16 +72,7 @@ class RunRequest:
     simulation_run: str | None = None  # a hardware run: the simulation run that passed its gate
     params: dict[str, object] = field(default_factory=dict)  # a launch file's global <param>s
     files: tuple[tuple[str, bytes], ...] = ()  # workspace data files, into every node's folder
-
-
-@dataclass
-class ActiveRun:
-    run: Run
-    user_id: str
-    telemetry: RunTelemetry
-    exercise: ExerciseEntry | None
-    hardware: str | None = None  # the bench robot's name, for a hardware run
-    started_wall: float = field(default_factory=time.monotonic)
+    case: int | None = None  # an exercise's grading case (seed and start), as `robodojo check`
 
 
 @dataclass(frozen=True, slots=True)
@@ -97,52 +87,21 @@ class LiveRun:
     sandbox_processes: int  # nodes with a live sandbox process
 
 
-class _Watch:
-    """The run's observer: live viewers get everything, the store gets state changes."""
-
-    def __init__(self, service: RunService, run_id: str, telemetry: RunTelemetry) -> None:
-        self.service = service
-        self.run_id = run_id
-        self.telemetry = telemetry
-        self._end: tuple[RunState, str, float] | None = None
-
-    def on_message(self, topic: str, type_name: str, time_ns: int, data: bytes) -> None:
-        self.telemetry.on_message(topic, type_name, time_ns, data)
-
-    def on_logs(self, node: str, lines: list[str]) -> None:
-        self.telemetry.on_logs(node, lines)
-
-    def on_state(self, state: RunState, reason: str, time_s: float) -> None:
-        if state.is_end:
-            # Viewers hear of the end after the results are stored and the checks judged, so
-            # the check results reach them before the socket closes.
-            self._end = (state, reason, time_s)
-            return
-        try:
-            with self.service.store.session() as db:
-                run_store.set_state(db, self.run_id, str(state))
-        except Exception:
-            log.exception("run %s: could not store state %s", self.run_id, state)
-        self.telemetry.on_state(state, reason, time_s)
-
-    def release_end(self) -> None:
-        state, reason, time_s = self._end or (RunState.FAILED, "failed: the run did not end", 0.0)
-        self.telemetry.on_state(state, reason, time_s)
-
-
 class RunService:
-    def __init__(self, store: Store, settings, launcher: Launcher, hardware=None) -> None:
+    def __init__(
+        self, store: Store, settings, launcher: Launcher, hardware=None, executor=None
+    ) -> None:
+        """`executor`: where runs execute (server/workers/seams.py RunExecutor); None: the one
+        the settings choose (server/workers/choose.py)."""
         self.hardware = hardware  # server/service/hardware.py HardwareHub, or None
         self.store = store
         self.settings = settings
         self.launcher = launcher
-        self.telemetry = TelemetryRegistry()
-        self._active: dict[str, ActiveRun] = {}
-        self._lock = threading.Lock()
+        if executor is None:
+            executor = make_executor(settings, store, launcher, hardware)
+        self.executor = executor
+        self._lock = threading.Lock()  # one start at a time here: counted, then stored
         self._closing = False
-        self._pool = ThreadPoolExecutor(
-            max_workers=settings.max_runs_total, thread_name_prefix="run"
-        )
         if hardware is not None:  # a run past its robot's time slot is told to stop
             hardware.listen(self.command)
 
@@ -173,10 +132,14 @@ class RunService:
                 f"({settings.max_run_duration_s:g} s)"
             )
         nodes = request.nodes
+        if request.case is not None and request.exercise is None:
+            raise RunRequestError("a case is one of an exercise's grading runs: name the exercise")
         if request.exercise is not None:
             exercise = request.exercise.exercise
             seed = request.seed if request.seed is not None else exercise.seeds[0]
             start = exercise.starts[0] if exercise.starts else None
+            if request.case is not None:
+                seed, start = _case(exercise, request.case, request.seed)
             spec = run_spec(exercise, nodes, seed, start)
             if duration is not None:  # a shorter try of an exercise is fine; it is judged as is
                 spec = _replace(spec, duration_s=duration)
@@ -207,66 +170,97 @@ class RunService:
         with self._lock:
             if self._closing:
                 raise RunLimitError("the server is shutting down; try again in a minute", 60)
-            mine = sum(1 for a in self._active.values() if a.user_id == user_id)
-            if mine >= self.settings.max_runs_per_student:
-                raise RunLimitError(
-                    f"you already have {mine} runs going (the limit is "
-                    f"{self.settings.max_runs_per_student}); stop one or wait for it to end",
-                    self.settings.retry_after_s,
-                )
-            if len(self._active) >= self.settings.max_runs_total:
-                raise RunLimitError(
-                    f"the lab is running its maximum of {self.settings.max_runs_total} runs; "
-                    f"try again in {self.settings.retry_after_s} s",
-                    self.settings.retry_after_s,
-                )
-            with self.store.session() as db:  # measured sizes, summed: no directory is walked
-                disk.check_budgets(db, user_id, self.settings)
             run_id = uuid.uuid4().hex
-            run_dir = Path(self.settings.runs_dir) / run_id
-            exercise = request.exercise
-            record = RunRecord(
-                id=run_id,
-                user_id=user_id,
-                exercise_id=exercise.exercise.id if exercise else None,
-                robot=spec.robot,
-                world=spec.world,
-                clock=str(spec.clock),
-                duration_s=spec.duration_s,
-                seed=spec.seed,
-                state=str(RunState.CREATED),
-                reason="",
-                created_at=time.time(),
-                code=[{"name": n.name, "code": n.code} for n in spec.nodes],
-                metrics={},
-                nodes={},
-                checks=[],
-                run_dir=str(run_dir),
-                hardware=request.hardware,
-                simulation_run_id=request.simulation_run if request.hardware else None,
-            )
-            # The robot is claimed before the run is stored: a refused run (not your turn, not
-            # connected) leaves no record, like any other refused request, instead of a run
-            # "created" forever in the student's history.
-            backend = None
-            if request.hardware is not None:
-                backend = self._claim_robot(request.hardware, user_id, run_id, spec)
+            claimed = False
             try:
-                run = Run(spec, self.launcher, run_dir, run_id=run_id, backend=backend)
-                with self.store.session() as db:
+                # Counted from the database and stored in one transaction under its write lock
+                # (an advisory lock on PostgreSQL): every web process of the lab agrees, and two
+                # admitting at once cannot both pass a count neither has added to yet.
+                with self.store.exclusive_session() as db:
+                    self._check_limits(db, user_id)
+                    record = self._record(run_id, user_id, request, spec)
+                    # The robot's turn is claimed before the run is stored: a refused run (not
+                    # your turn, not connected) leaves no record, like any other refused
+                    # request, instead of a run "created" forever in the student's history. The
+                    # worker holding the robot's connection gives the slot back when it ends.
+                    if request.hardware is not None:
+                        self._claim_robot(request.hardware, user_id, run_id, spec)
+                        claimed = True
                     run_store.add(db, record)
             except BaseException:
-                if request.hardware is not None:  # the robot's slot goes to the next in line
-                    self.hardware.queue(request.hardware).finish(run_id, time.monotonic())
+                if claimed:
+                    self._release_robot(request.hardware, run_id)
                 raise
-            telemetry = self.telemetry.create(run_id)
-            run.observer = _Watch(self, run_id, telemetry)
-            self._active[run_id] = ActiveRun(run, user_id, telemetry, exercise, request.hardware)
-        self._pool.submit(self._execute, run_id)
+            job = RunJob(
+                run_id=run_id,
+                user_id=user_id,
+                spec=spec,
+                run_dir=record.run_dir,
+                exercise_id=record.exercise_id,
+                hardware=request.hardware,
+                queued_wall_s=time.time(),
+            )
+            try:
+                self.executor.submit(job)
+            except BaseException as error:
+                self._release_robot(request.hardware, run_id)
+                with self.store.session() as db:
+                    stored = run_store.get(db, run_id)
+                    stored.state, stored.ended_at = str(RunState.FAILED), time.time()
+                    stored.reason = (
+                        f"failed: {error}"
+                        if isinstance(error, ExecutorUnavailableError)
+                        else f"failed: the run could not be queued ({error!r})"
+                    )
+                if isinstance(error, ExecutorUnavailableError):
+                    raise RunLimitError(str(error), self.settings.retry_after_s) from None
+                raise
         return record
 
-    def _claim_robot(self, name: str, user_id: str, run_id: str, spec: RunSpec):
-        """The bench robot for this run, if it is the user's turn (raises with a sentence)."""
+    def _check_limits(self, db, user_id: str) -> None:
+        """Raises RunLimitError (or DiskBudgetError) when this student or the lab is full."""
+        mine = run_store.active_count(db, user_id)
+        total = run_store.active_count(db)
+        disk.check_budgets(db, user_id, self.settings)  # measured sizes, summed
+        if mine >= self.settings.max_runs_per_student:
+            raise RunLimitError(
+                f"you already have {mine} runs going (the limit is "
+                f"{self.settings.max_runs_per_student}); stop one or wait for it to end",
+                self.settings.retry_after_s,
+            )
+        if total >= self.settings.max_runs_total:
+            raise RunLimitError(
+                f"the lab is running its maximum of {self.settings.max_runs_total} runs; "
+                f"try again in {self.settings.retry_after_s} s",
+                self.settings.retry_after_s,
+            )
+
+    def _record(self, run_id: str, user_id: str, request: RunRequest, spec: RunSpec) -> RunRecord:
+        """The run's record as it is first stored: "created", not yet taken by a worker."""
+        exercise = request.exercise
+        return RunRecord(
+            id=run_id,
+            user_id=user_id,
+            exercise_id=exercise.exercise.id if exercise else None,
+            robot=spec.robot,
+            world=spec.world,
+            clock=str(spec.clock),
+            duration_s=spec.duration_s,
+            seed=spec.seed,
+            state=str(RunState.CREATED),
+            reason="",
+            created_at=time.time(),
+            code=[{"name": n.name, "code": n.code} for n in spec.nodes],
+            metrics={},
+            nodes={},
+            checks=[],
+            run_dir=str(Path(self.settings.runs_dir) / run_id),
+            hardware=request.hardware,
+            simulation_run_id=request.simulation_run if request.hardware else None,
+        )
+
+    def _claim_robot(self, name: str, user_id: str, run_id: str, spec: RunSpec) -> None:
+        """Take the user's turn on the bench robot (raises with a sentence when it is not)."""
         if self.hardware is None:
             raise RunRequestError("this server has no hardware support switched on")
         with self.store.session() as db:
@@ -276,145 +270,75 @@ class RunService:
                     f"no robot named '{name}' on the bench; robots: {inventory.names(db)}"
                 )
             kind, in_service = entry.kind, entry.in_service
-            limits, watchdog_s = dict(entry.limits), entry.watchdog_s
         if kind != spec.robot:
             raise RunRequestError(f"'{name}' is a {kind}; this run needs a {spec.robot}")
         if not in_service:
             raise RunRequestError(f"'{name}' is out of service; ask your instructor")
-        link = self.hardware.link(name)
-        if link is None:
+        if self.hardware.link(name) is None:
             raise RunRequestError(f"'{name}' is not connected; switch it on or ask your instructor")
         try:
             self.hardware.queue(name).start(user_id, run_id, time.monotonic())
         except QueueError as error:
             raise RunLimitError(str(error), self.settings.retry_after_s) from None
-        try:
-            link.drain()
-            return HardwareRobot(kind, link, MotionLimits(**limits), watchdog_s)
-        except BaseException:
+
+    def _release_robot(self, name: str | None, run_id: str) -> None:
+        if name is not None and self.hardware is not None:  # the slot goes to the next in line
             self.hardware.queue(name).finish(run_id, time.monotonic())
-            raise
 
     def command(self, run_id: str, command: RunCommand) -> bool:
         """Send a command (server/runs/commands.py) to a running run; False when it is not
         running (any more). Raises CommandError when the run's state refuses it now."""
-        active = self._active.get(run_id)
-        if active is None:
-            return False
-        active.run.command(command)
-        return True
-
-    # ------------------------------------------------------------------------------ running
-    def _execute(self, run_id: str) -> None:
-        active = self._active[run_id]
-        run = active.run
-        result: RunResult | None = None
-        try:
-            result = run.execute()
-        except Exception as error:  # execute() should not raise; if it does, this run ends
-            log.exception("run %s raised out of execute()", run_id)
-            reason = f"failed: internal error ({error!r})"
-            self._store_end(run_id, RunState.FAILED, reason, None, active)
-        else:
-            self._store_end(run_id, result.state, result.reason, result, active)
-        finally:
-            with self._lock:
-                self._active.pop(run_id, None)
-            if active.hardware is not None and self.hardware is not None:
-                self.hardware.queue(active.hardware).finish(run_id, time.monotonic())
-            watch = run.observer
-            if isinstance(watch, _Watch):
-                watch.release_end()
-
-    def _store_end(
-        self,
-        run_id: str,
-        state: RunState,
-        reason: str,
-        result: RunResult | None,
-        active: ActiveRun,
-    ) -> None:
-        checks: list[dict] = []
-        score = None
-        if result is not None and active.exercise is not None:
-            try:
-                checks, score = judge_run(active.exercise.exercise, result, active.run.out_dir)
-            except Exception as error:
-                log.exception("run %s: judging failed", run_id)
-                checks = [{"name": "judging", "passed": False, "error": repr(error)}]
-                score = 0.0
-        with self.store.session() as db:
-            record = run_store.get(db, run_id)
-            if record is None:
-                return
-            record.state = str(state)
-            record.reason = reason
-            record.ended_at = time.time()
-            if result is not None:
-                record.sim_time_s = result.duration_s
-                record.wall_s = result.wall_s
-                record.metrics = json_safe(result.metrics)
-                record.nodes = json_safe(result.summary()["nodes"])
-            record.checks = json_safe(checks)
-            record.score = score
-            record.disk_bytes = disk.dir_bytes(active.run.out_dir)  # once, for the budgets
-        if checks:
-            active.telemetry.on_event(
-                {"type": "checks", "checks": json_safe(checks), "score": score}
-            )
+        return self.executor.command(run_id, command)
 
     # ------------------------------------------------------------------------------ reading
-    # Whatever reads a running Run is here, and only here: callers get data, not the run.
+    # Whatever reads a running run is here, and only here: callers get data, not the run.
     def is_running(self, run_id: str) -> bool:
-        """Whether the run is still in the service (going, or being judged and stored)."""
-        return run_id in self._active
+        """Whether the run is still held (queued, going, or being judged and stored)."""
+        return self.executor.is_running(run_id)
 
     def live(self, run_id: str) -> LiveRun | None:
         """A snapshot of a running run; None when it is not running (any more)."""
-        active = self._active.get(run_id)
-        if active is None:
+        status = self.executor.status(run_id)
+        if status is None:
             return None
-        run = active.run
-        slots = dict(run.slots)
         return LiveRun(
             run_id=run_id,
-            state=run.state,
-            time_s=run.time_s,
-            ros_version=run.dialect.ros_version,
-            node_periods={
-                name: slot.metrics.period.recent_summary() for name, slot in slots.items()
-            },
-            sandbox_processes=sum(1 for slot in slots.values() if slot.process is not None),
+            state=RunState(status.state),
+            time_s=status.time_s,
+            ros_version=status.ros_version,
+            node_periods=status.node_periods,
+            sandbox_processes=status.sandbox_processes,
         )
 
     def logs(self, run_id: str) -> dict[str, list[str]] | None:
         """What each node of a running run printed so far; None when it is not running."""
-        active = self._active.get(run_id)
-        if active is None:
-            return None
-        return {name: list(slot.logs) for name, slot in dict(active.run.slots).items()}
+        status = self.executor.status(run_id)
+        return dict(status.logs) if status is not None else None
 
     def graph(self, run_id: str) -> dict | None:
         """A running run's nodes and topics with measured rates; None when it is not running."""
-        active = self._active.get(run_id)
-        return active.run.bus.graph() if active is not None else None
+        status = self.executor.status(run_id)
+        return status.graph if status is not None else None
 
     def lights(self, run_id: str) -> tuple[LightSource, ...] | None:
-        """Where a running run's lights are now (the simulation replaces the tuple whole when
-        one moves, so it is read safely from here); None when it is not running (or its robot
-        is not made yet)."""
-        active = self._active.get(run_id)
-        robot = active.run.sim if active is not None else None
-        return tuple(robot.lights) if robot is not None else None
+        """Where a running run's lights are now; None when it is not running (or its robot is
+        not made yet)."""
+        status = self.executor.status(run_id)
+        if status is None or status.lights is None:
+            return None
+        return tuple(LightSource(**light) for light in status.lights)
 
     def feed(self, run_id: str) -> RunTelemetry | None:
-        """A running run's telemetry, for a viewer to follow; None when it is not running."""
-        active = self._active.get(run_id)
-        return active.telemetry if active is not None else None
+        """A run's live telemetry, for a viewer to follow; None when it has none here (never
+        ran, or ended long ago)."""
+        return self.executor.feed(run_id)
 
-    def _actives(self) -> list[ActiveRun]:
-        with self._lock:
-            return list(self._active.values())
+    def _active_ids(self, user_id: str | None = None) -> list[str]:
+        with self.store.session() as db:
+            records, _ = run_store.listing(
+                db, RunFilter(user_id=user_id, state="active", limit=run_store.MAX_LISTED)
+            )
+            return [record.id for record in records]
 
     # ------------------------------------------------------------------------------ controls
     def stop(self, run_id: str, reason: str = "stopped by the user") -> bool:
@@ -423,37 +347,47 @@ class RunService:
 
     def stop_user(self, user_id: str, reason: str) -> int:
         stopped = 0
-        for active in self._actives():
-            if active.user_id == user_id:
-                active.run.command(Stop(reason))
-                stopped += 1
+        for run_id in self._active_ids(user_id):
+            with contextlib.suppress(CommandError):  # refused: it is ending already
+                stopped += self.command(run_id, Stop(reason))
         return stopped
 
     def shutdown(self) -> None:
-        """Stop every run (robots commanded to zero as each ends) and wait for them."""
+        """Stop every run this process executes (robots commanded to zero as each ends) and
+        wait for them, up to shutdown_grace_s."""
         with self._lock:
             self._closing = True
-            actives = list(self._active.values())
-        for active in actives:
-            active.run.command(Stop("the server is shutting down"))
-        deadline = time.monotonic() + self.settings.shutdown_grace_s
-        while self._active and time.monotonic() < deadline:
-            time.sleep(0.05)
-        self._pool.shutdown(wait=False, cancel_futures=True)
+        self.executor.shutdown(self.settings.shutdown_grace_s)
 
     def status(self) -> dict:
-        with self._lock:
-            run_ids = list(self._active)
-        lives = [live for live in map(self.live, run_ids) if live is not None]
+        statuses = [self.executor.status(run_id) for run_id in self._active_ids()]
+        lives = [status for status in statuses if status is not None]
+        feeds = [self.executor.feed(status.run_id) for status in lives]
         return {
             "active_runs": len(lives),
-            "active_by_state": _count(str(live.state) for live in lives),
-            "sandbox_processes": sum(live.sandbox_processes for live in lives),
-            "warm_pool": self.launcher.warm_count,
+            "active_by_state": _count(status.state for status in lives),
+            "sandbox_processes": sum(status.sandbox_processes for status in lives),
+            # Warm sandboxes here and, for worker processes of this machine, there.
+            "warm_pool": self.launcher.warm_count + getattr(self.executor, "warm_count", int)(),
             "max_runs_total": self.settings.max_runs_total,
             "max_runs_per_student": self.settings.max_runs_per_student,
-            "live_viewers": self.telemetry.viewer_count(),
+            "live_viewers": sum(feed.viewer_count for feed in feeds if feed is not None),
+            "workers": self.executor.workers(),
         }
+
+
+def _case(exercise, index: int, seed: int | None):
+    """The seed and start pose of an exercise's grading case `index` (cases_of, as `robodojo
+    check` runs them), or RunRequestError with a sentence."""
+    cases = cases_of(exercise)
+    if seed is not None:
+        raise RunRequestError("give a case or a seed, not both: a case chooses its own seed")
+    if not 0 <= index < len(cases):
+        raise RunRequestError(
+            f"exercise '{exercise.id}' has {len(cases)} grading cases (0 to {len(cases) - 1}); "
+            f"there is no case {index}"
+        )
+    return cases[index].seed, cases[index].start
 
 
 def node_spec(name: str, code: str, **ros) -> NodeSpec:

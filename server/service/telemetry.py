@@ -76,6 +76,7 @@ class _Sample:
     time_ns: int  # [ns] run clock
     data: bytes
     received_s: float  # [s] time.monotonic() when the run handed it over
+    produced_wall_s: float  # [s] time.time() when the run produced it (on whichever machine)
     decoded: dict[str, Any] | None = None
     error: str | None = None
 
@@ -105,7 +106,49 @@ class RunTelemetry:
         self._latencies_s: deque[float] = deque(maxlen=LATENCIES_KEPT)
 
     # ------------------------------------------------------------------- RunObserver (run thread)
-    def on_message(self, topic: str, type_name: str, time_ns: int, data: bytes) -> None:
+    def on_message(
+        self,
+        topic: str,
+        type_name: str,
+        time_ns: int,
+        data: bytes,
+        produced_wall_s: float | None = None,
+    ) -> None:
+        """`produced_wall_s`: time.time() when the run produced the message, given by a mirror
+        of a run elsewhere (a worker's Sample.wall_s); now, when the run calls directly."""
+        if produced_wall_s is None:
+            self._put(topic, type_name, time_ns, data, time.monotonic(), time.time(), 0)
+        else:
+            self.on_sample(topic, type_name, time_ns, data, produced_wall_s, 0)
+
+    def on_sample(
+        self,
+        topic: str,
+        type_name: str,
+        time_ns: int,
+        data: bytes,
+        produced_wall_s: float,
+        skipped: int,
+    ) -> None:
+        """A sample of a run elsewhere (server/workers/mirror.py): the newest on its topic when
+        the worker sent it, `skipped` older ones overwritten there, so a viewer's `dropped`
+        count stays true. Its delivery latency counts from when the worker produced it
+        (`produced_wall_s`, time.time() on a machine sharing this clock), not from now."""
+        waited_s = min(max(0.0, time.time() - produced_wall_s), 3600.0)
+        self._put(
+            topic, type_name, time_ns, data, time.monotonic() - waited_s, produced_wall_s, skipped
+        )
+
+    def _put(
+        self,
+        topic: str,
+        type_name: str,
+        time_ns: int,
+        data: bytes,
+        received_s: float,
+        produced_wall_s: float,
+        skipped: int,
+    ) -> None:
         if is_internal(topic):
             return  # a service's request/answer topics: in the recording, not for plots
         previous = self._latest.get(topic)
@@ -113,10 +156,10 @@ class RunTelemetry:
             with self._lock:
                 self._topics[topic] = type_name
                 self._append_event({"type": "topic", "topic": topic, "msg_type": type_name})
-            seq = 1
+            seq = 1 + max(0, skipped)
         else:
-            seq = previous.seq + 1
-        self._latest[topic] = _Sample(seq, type_name, time_ns, data, time.monotonic())
+            seq = previous.seq + 1 + max(0, skipped)
+        self._latest[topic] = _Sample(seq, type_name, time_ns, data, received_s, produced_wall_s)
         for viewer in self._viewers:
             if previous is None or topic in viewer._subscriptions:
                 viewer._poke()
@@ -363,6 +406,9 @@ class Viewer:
             "time_s": sample.time_ns / 1e9,
             "msg": sample.decoded,
             "dropped": sample.seq - sub.sent_seq - 1,
+            # Production time on the run's machine: delivery latency end to end for whoever
+            # shares its clock (bench/bench_cluster.py); a browser may ignore it.
+            "wall_s": sample.produced_wall_s,
         }
         if sample.error is not None:
             frame["error"] = sample.error

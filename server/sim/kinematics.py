@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import math
 
-_STRAIGHT_EPS = 1e-9  # [rad] |w dt| below this the arc is a straight line (avoid v/w blow-up)
+STRAIGHT_TURN_RAD = 1e-9  # [rad] |w dt| below this the arc is a straight line (avoid v/w blow-up)
 
 
 def wrap_angle(angle_rad: float) -> float:
@@ -36,7 +36,7 @@ def integrate_arc(
     Returns the new (x [m], y [m], yaw [rad] wrapped to (-pi, pi]).
     """
     turn = angular_rad_s * dt_s
-    if abs(turn) < _STRAIGHT_EPS:
+    if abs(turn) < STRAIGHT_TURN_RAD:
         # Midpoint heading keeps second-order accuracy for the tiny residual turn.
         heading = yaw + 0.5 * turn
         return (

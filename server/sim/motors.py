@@ -24,6 +24,8 @@ import functools
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 from server.sim.kinematics import wheel_speeds
 
 # CrowBot firmware constants (000 Table 2, firmware in shared/seeds/README.md).
@@ -35,6 +37,12 @@ CROWBOT_PWM_MAX = 255  # [counts] 8-bit PWM (ESP32 ledc, 8-bit resolution)
 CROWBOT_PWM_DEAD_BAND = 20  # [counts]
 # Assumption: a small geared motor carrying a 0.2 kg robot reaches 63% of a step in ~50 ms.
 CROWBOT_MOTOR_TIME_CONSTANT_S = 0.05  # [s]
+
+
+# [rad/s] A wheel this close to its target has settled (`steady_speeds`): what is left of its
+# lag would move the robot by about wheel radius x time constant x this, ~1e-12 m, which is
+# float rounding on a pose.
+SETTLED_RAD_S = 1e-9
 
 
 @functools.lru_cache(maxsize=64)
@@ -49,6 +57,56 @@ def _lag_factor(dt_s: float, time_constant_s: float) -> float:
 def _lag(current: float, target: float, dt_s: float, time_constant_s: float) -> float:
     """Exact first-order lag step toward `target`."""
     return target + (current - target) * _lag_factor(dt_s, time_constant_s)
+
+
+@functools.lru_cache(maxsize=256)
+def _lag_powers(factor: float, ticks: int) -> np.ndarray:
+    """factor**1 .. factor**ticks, read-only: the part of the old error left after each tick."""
+    powers = factor ** np.arange(1, ticks + 1, dtype=np.float64)
+    powers.flags.writeable = False
+    return powers
+
+
+def _lag_many(current: float, target: float, ticks: int, factor: float) -> np.ndarray:
+    """The speeds after each of `ticks` exact lag steps (`_lag` applied `ticks` times, in
+    closed form; equal to the repeated steps within float rounding)."""
+    return target + (current - target) * _lag_powers(factor, ticks)
+
+
+def _ramp_then_lag(
+    current: float, target: float, ticks: int, factor: float, max_change: float
+) -> np.ndarray:
+    """`VelocityMotors._advance` applied `ticks` times, in closed form. While the lag would
+    change the speed by more than `max_change` in one tick, the speed ramps by exactly that
+    much (a straight line); once it would not, it never will again (the gap only shrinks), and
+    the rest is the plain lag."""
+    gap = abs(target - current)
+    # Nothing to follow, no acceleration allowed, or a lag that never moves (tau >> dt).
+    if gap == 0.0 or max_change <= 0.0 or factor >= 1.0:
+        return np.full(ticks, current)
+    # Tick k (from 1) is clamped while gap - (k - 1) * max_change > max_change / (1 - factor).
+    ramp_ticks = max(0, math.ceil(gap / max_change - 1.0 / (1.0 - factor)))
+    ramp_ticks = min(ramp_ticks, ticks)
+    if ramp_ticks == 0:
+        return _lag_many(current, target, ticks, factor)
+    step = math.copysign(max_change, target - current)
+    ramp = current + step * np.arange(1, ramp_ticks + 1, dtype=np.float64)
+    if ramp_ticks == ticks:
+        return ramp
+    rest = _lag_many(float(ramp[-1]), target, ticks - ramp_ticks, factor)
+    return np.concatenate((ramp, rest))
+
+
+def _settle(motors, left: float, right: float) -> tuple[float, float] | None:
+    """(left, right) [rad/s] when both of `motors`' wheels are within SETTLED_RAD_S of these
+    speeds, which they are then set to exactly (they stay until the next command); else None."""
+    if (
+        abs(motors.left_rad_s - left) < SETTLED_RAD_S
+        and abs(motors.right_rad_s - right) < SETTLED_RAD_S
+    ):
+        motors.left_rad_s, motors.right_rad_s = left, right
+        return left, right
+    return None
 
 
 def crowbot_pwm(wheel_rad_s: float) -> int:
@@ -95,6 +153,21 @@ class CrowBotFirmwareMotors:
         )
         return self.left_rad_s, self.right_rad_s
 
+    def steady_speeds(self) -> tuple[float, float] | None:
+        """(left, right) [rad/s] when both wheels have settled on their speeds (set to them
+        exactly: they stay until the next command), else None."""
+        return _settle(
+            self, self._duty_to_speed(self.left_pwm), self._duty_to_speed(self.right_pwm)
+        )
+
+    def step_many(self, dt_s: float, ticks: int) -> tuple[np.ndarray, np.ndarray]:
+        """`step(dt_s)` `ticks` times at once: (left, right) wheel speeds [rad/s] after each."""
+        factor = _lag_factor(dt_s, self.time_constant_s)
+        left = _lag_many(self.left_rad_s, self._duty_to_speed(self.left_pwm), ticks, factor)
+        right = _lag_many(self.right_rad_s, self._duty_to_speed(self.right_pwm), ticks, factor)
+        self.left_rad_s, self.right_rad_s = float(left[-1]), float(right[-1])
+        return left, right
+
 
 @dataclass(slots=True)
 class VelocityMotors:
@@ -133,6 +206,20 @@ class VelocityMotors:
         self.left_rad_s = self._advance(self.left_rad_s, self.target_left_rad_s, dt_s)
         self.right_rad_s = self._advance(self.right_rad_s, self.target_right_rad_s, dt_s)
         return self.left_rad_s, self.right_rad_s
+
+    def steady_speeds(self) -> tuple[float, float] | None:
+        """(left, right) [rad/s] when both wheels have settled on their targets (set to them
+        exactly: they stay until the next command), else None."""
+        return _settle(self, self.target_left_rad_s, self.target_right_rad_s)
+
+    def step_many(self, dt_s: float, ticks: int) -> tuple[np.ndarray, np.ndarray]:
+        """`step(dt_s)` `ticks` times at once: (left, right) wheel speeds [rad/s] after each."""
+        factor = _lag_factor(dt_s, self.time_constant_s)
+        max_change = self.max_wheel_accel_rad_s2 * dt_s
+        left = _ramp_then_lag(self.left_rad_s, self.target_left_rad_s, ticks, factor, max_change)
+        right = _ramp_then_lag(self.right_rad_s, self.target_right_rad_s, ticks, factor, max_change)
+        self.left_rad_s, self.right_rad_s = float(left[-1]), float(right[-1])
+        return left, right
 
 
 # TurtleBot3 Burger firmware constants (OpenCR noetic-devel, turtlebot3_motor_driver.h and
@@ -204,3 +291,26 @@ class OpenCrMotors:
             self.since_control_s %= self.control_period_s
             self._control()
         return self.wheels.step(dt_s)
+
+    def step_many(self, dt_s: float, ticks: int) -> tuple[np.ndarray, np.ndarray]:
+        """`step(dt_s)` `ticks` times at once. The firmware's timers are kept tick by tick, as
+        `step` keeps them (cheap, and the control passes land on the same ticks); the wheels
+        follow each pass's goal in one closed-form run."""
+        lefts, rights = [], []
+        run_start = 0
+        for tick in range(ticks):
+            self.since_command_s += dt_s
+            self.since_control_s += dt_s
+            if self.since_control_s >= self.control_period_s - 1e-12:
+                if tick > run_start:
+                    left, right = self.wheels.step_many(dt_s, tick - run_start)
+                    lefts.append(left)
+                    rights.append(right)
+                    run_start = tick
+                self.since_control_s = max(self.since_control_s - self.control_period_s, 0.0)
+                self.since_control_s %= self.control_period_s
+                self._control()
+        left, right = self.wheels.step_many(dt_s, ticks - run_start)
+        if not lefts:
+            return left, right
+        return np.concatenate((*lefts, left)), np.concatenate((*rights, right))

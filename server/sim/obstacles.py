@@ -40,7 +40,7 @@ from server.sim.raycast_few import (
     Segment,
     cast_few,
     clearance_few,
-    penetrations_few,
+    contacts_few,
 )
 from server.sim.world import World
 
@@ -385,33 +385,46 @@ class Obstacles:
         each overlapping surface, `angle` (P,) the world-frame direction from the centre to each
         touching surface [rad]. Empty arrays when nothing touches.
         """
+        push, angle, _ = self.contacts(centre_x, centre_y, radius_m)
+        return push, angle
+
+    def contacts(
+        self, centre_x: float, centre_y: float, radius_m: float
+    ) -> tuple[np.ndarray, np.ndarray, float]:
+        """`penetrations` and `clearance` of the same centre in one pass over the surfaces:
+        (push, angle, distance [m] from the centre to the nearest surface)."""
         if self._few_surfaces:
-            few = penetrations_few(
+            few, nearest = contacts_few(
                 self._few_segments, self._few_circles, centre_x, centre_y, radius_m
             )
             if not few:
-                return np.zeros((0, 2)), np.zeros(0)
+                return np.zeros((0, 2)), np.zeros(0), nearest
             push = np.array(few)
-            return push, np.arctan2(-push[:, 1], -push[:, 0])
+            return push, np.arctan2(-push[:, 1], -push[:, 0]), nearest
         centre = np.array([centre_x, centre_y])
         pushes: list[np.ndarray] = []
-        away, gap = self._away_from_segments(centre)
-        touching = gap < radius_m
-        if touching.any():
-            g = np.maximum(gap[touching], 1e-9)
-            pushes.append(away[touching] / g[:, None] * (radius_m - g)[:, None])
-        away_c = centre - self.circle_centre
-        gap_c = np.hypot(away_c[:, 0], away_c[:, 1])
-        overlap = radius_m + self.circle_radius - gap_c
-        touching_c = overlap > 0.0
-        if touching_c.any():
-            g = np.maximum(gap_c[touching_c], 1e-9)
-            pushes.append(away_c[touching_c] / g[:, None] * overlap[touching_c][:, None])
+        nearest = math.inf
+        if self.segment_height.size:
+            away, gap = self._away_from_segments(centre)
+            nearest = float(np.min(gap))
+            touching = gap < radius_m
+            if touching.any():
+                g = np.maximum(gap[touching], 1e-9)
+                pushes.append(away[touching] / g[:, None] * (radius_m - g)[:, None])
+        if self.circle_radius.size:
+            away_c = centre - self.circle_centre
+            gap_c = np.hypot(away_c[:, 0], away_c[:, 1])
+            nearest = min(nearest, float(np.min(gap_c - self.circle_radius)))
+            overlap = radius_m + self.circle_radius - gap_c
+            touching_c = overlap > 0.0
+            if touching_c.any():
+                g = np.maximum(gap_c[touching_c], 1e-9)
+                pushes.append(away_c[touching_c] / g[:, None] * overlap[touching_c][:, None])
         if not pushes:
-            return np.zeros((0, 2)), np.zeros(0)
+            return np.zeros((0, 2)), np.zeros(0), nearest
         push = np.concatenate(pushes)
         angle = np.arctan2(-push[:, 1], -push[:, 0])
-        return push, angle
+        return push, angle, nearest
 
     def clearance(self, x: float, y: float) -> float:
         """Distance [m] from the point (x, y) to the nearest surface (inf in an empty world)."""

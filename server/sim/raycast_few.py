@@ -97,26 +97,31 @@ def _closest_on_segment(seg: Segment, x: float, y: float) -> tuple[float, float]
     return rel_x - along * seg.edge_x, rel_y - along * seg.edge_y
 
 
-def penetrations_few(
+def contacts_few(
     segments: list[Segment], circles: list[Circle], x: float, y: float, radius_m: float
-) -> list[tuple[float, float]]:
+) -> tuple[list[tuple[float, float]], float]:
     """Push-out vectors for every surface a disc of `radius_m` at (x, y) overlaps (segments
-    first, then circles, as `Obstacles.penetrations` orders them)."""
+    first, then circles, as `Obstacles.contacts` orders them), and the distance [m] from (x, y)
+    to the nearest surface (as `clearance_few`), in one pass."""
     pushes = []
+    nearest = math.inf
     for seg in segments:
         away_x, away_y = _closest_on_segment(seg, x, y)
         gap = math.hypot(away_x, away_y)
+        nearest = min(nearest, gap)
         if gap < radius_m:
             gap = max(gap, 1e-9)
             pushes.append((away_x / gap * (radius_m - gap), away_y / gap * (radius_m - gap)))
     for circle in circles:
         away_x, away_y = x - circle.x, y - circle.y
         gap = math.hypot(away_x, away_y)
-        overlap = radius_m + math.sqrt(circle.radius_sq) - gap
+        circle_radius = math.sqrt(circle.radius_sq)
+        nearest = min(nearest, gap - circle_radius)
+        overlap = radius_m + circle_radius - gap
         if overlap > 0.0:
             gap = max(gap, 1e-9)
             pushes.append((away_x / gap * overlap, away_y / gap * overlap))
-    return pushes
+    return pushes, nearest
 
 
 def clearance_few(segments: list[Segment], circles: list[Circle], x: float, y: float) -> float:

@@ -7,6 +7,10 @@ Contract (checked, with sentences that say what to do):
     sim.read("Distance")                   # latest message on a topic (None before the first)
     sim.scene()                            # what to draw
 
+The ticks between two events (a command, a sensor sample, the end of a step) are evaluated
+together where nothing but motion happens (server/sim/tick_runs.py): the same ticks, within float
+rounding; contacts and bounds crossings are taken one tick at a time (`tick_runs=False`: all).
+
 Pure: no I/O, no wall clock. Time is kept in integer nanoseconds of simulated time, so tick and
 sensor schedules never drift with float rounding; each sensor topic publishes at `phase +
 k / rate` on the first tick at or after that instant. Randomness comes from one seed, split into
@@ -19,18 +23,26 @@ from __future__ import annotations
 
 import math
 import zlib
-from dataclasses import dataclass
-from enum import StrEnum
 
 import numpy as np
 
 from sandbox.units import NS_PER_S
 from server.sim.kinematics import body_velocities, integrate_arc, wrap_angle
 from server.sim.obstacles import Obstacles
+from server.sim.records import EventKind, Published, Scene, SimEvent
 from server.sim.registry import get_robot, robots_for_world
 from server.sim.robots.base import Direction, TopicSpec
 from server.sim.sensors.base import SenseContext, Sensor
 from server.sim.state import Pose2D, RobotState
+from server.sim.tick_runs import (
+    MIN_TICKS_FOR_A_RUN,
+    ArrayRun,
+    RunPoint,
+    RunStart,
+    SteadyRun,
+    move_along,
+    plan_run,
+)
 from server.sim.world import LightSource, World, WorldError, load_world
 
 DEFAULT_PHYSICS_HZ = 1000.0  # [Hz] fine enough that a 0.13 m/s robot moves 0.13 mm per tick
@@ -42,50 +54,6 @@ _COLLISION_ITERATIONS = 4  # push-out passes per tick; a corner needs one per wa
 
 class SimulationError(ValueError):
     """A call the simulation cannot accept; the message says what to do instead."""
-
-
-@dataclass(frozen=True, slots=True)
-class Published:
-    """A message a sensor topic published at simulated time `time_s` [s]."""
-
-    topic: str
-    time_s: float
-    message: object
-
-
-class EventKind(StrEnum):
-    CONTACT_BEGAN = "contact_began"
-    CONTACT_ENDED = "contact_ended"
-    LEFT_BOUNDS = "left_bounds"
-    ENTERED_BOUNDS = "entered_bounds"
-
-
-@dataclass(frozen=True, slots=True)
-class SimEvent:
-    """Something a run may want to count or show, at `time_s` [s], the robot at x, y [m]."""
-
-    kind: EventKind
-    time_s: float
-    x: float
-    y: float
-
-
-@dataclass(frozen=True, slots=True)
-class Scene:
-    """A snapshot for drawing: the true pose, actuator states, light positions, and the latest
-    message on every topic (the 3D view draws rays from those)."""
-
-    time_s: float
-    robot_id: str
-    world_id: str
-    pose: Pose2D
-    leds_rgb: tuple[int, int, int]
-    buzzer_on: bool
-    servo_angle_deg: float
-    in_contact: bool
-    lights: tuple[LightSource, ...]
-    latest: dict[str, object]
-    rays: dict[str, np.ndarray]  # topic -> (K, 4) world segments of what the sensor measured
 
 
 def _topic_rng(seed: int, topic: str) -> np.random.Generator:
@@ -123,7 +91,11 @@ class Simulation:
         seed: int = 0,
         spawn: str | Pose2D | None = None,
         physics_hz: float = DEFAULT_PHYSICS_HZ,
+        tick_runs: bool = True,
     ) -> None:
+        """`tick_runs`: evaluate the ticks between two events as arrays (server/sim/tick_runs.py:
+        the same ticks, within float rounding); False steps every tick on its own, the
+        reference the tests hold tick runs to."""
         self.robot = get_robot(robot)
         self.world = world if isinstance(world, World) else load_world(world)
         if self.robot.id not in self.world.robots:
@@ -135,6 +107,7 @@ class Simulation:
             raise SimulationError(f"physics_hz must be between 10 and 100000, got {physics_hz}")
         self._tick_ns = round(NS_PER_S / physics_hz)
         self._tick_s = self._tick_ns / NS_PER_S
+        self._tick_runs = bool(tick_runs)
         self.obstacles = Obstacles(self.world)
         self._topics = {spec.name: spec for spec in self.robot.topics()}
         self._spawn = spawn
@@ -174,6 +147,7 @@ class Simulation:
         self._latest: dict[str, object] = {}
         self._events: list[SimEvent] = []
         self._clearance_m = 0.0
+        self._single_ticks = 0  # ticks to take one by one before planning a run again
         self._out_of_bounds = not self.world.in_bounds(spawn.x, spawn.y)
         return self._publish_due()
 
@@ -289,10 +263,78 @@ class Simulation:
             )
         self._target_ns += round(dt_s * NS_PER_S)
         published: list[Published] = []
-        while self._now_ns + self._tick_ns <= self._target_ns:
-            self._tick()
-            published.extend(self._publish_due())
+        tick_ns = self._tick_ns
+        while self._now_ns + tick_ns <= self._target_ns:
+            ticks = (self._target_ns - self._now_ns) // tick_ns
+            run = self._plan_run(ticks)
+            if run is None:
+                self._tick()
+                published.extend(self._publish_due())
+            else:
+                published.extend(self._follow(run))
         return published
+
+    # ----------------------------------------------------------------------------- tick runs
+    def _plan_run(self, ticks: int) -> ArrayRun | SteadyRun | None:
+        """The next `ticks` ticks (or the first part of them) as one run where nothing but
+        motion happens (server/sim/tick_runs.py); None: take the next tick on its own (in
+        contact, out of bounds, clearance used up, a short stretch)."""
+        state, motors = self.state, self.motors
+        if self._single_ticks > 0:
+            self._single_ticks -= 1
+            return None
+        if (
+            not self._tick_runs
+            or ticks < MIN_TICKS_FOR_A_RUN
+            or state.in_contact
+            or self._out_of_bounds
+            or self._clearance_m <= 0.0
+            or not hasattr(motors, "step_many")
+            or not hasattr(motors, "__dataclass_fields__")  # no state to put back
+        ):
+            return None
+        pose, odom = state.pose, state.odometry_pose
+        start = RunStart(
+            pose=(pose.x, pose.y, pose.yaw),
+            odometry=(odom.x, odom.y, odom.yaw),
+            clearance_m=self._clearance_m,
+            bounds=self.world.bounds,
+            wheel_radius_m=self._wheel_radius_m,
+            track_m=self._track_m,
+            odometry_scales=(self._odom_left_scale, self._odom_right_scale),
+            body_offset_m=self.robot.geometry.body_offset_x_m,
+            tick_s=self._tick_s,
+        )
+        run = plan_run(start, motors, ticks)
+        if run.ticks < MIN_TICKS_FOR_A_RUN:
+            # One by one up to where the clearance runs out or the bounds are crossed.
+            self._single_ticks = run.ticks
+            return None
+        return run
+
+    def _follow(self, run: ArrayRun | SteadyRun) -> list[Published]:
+        """Move the state along `run`, stopping at each tick where a sensor falls due to let
+        it sample the robot there."""
+        published = []
+        tick_ns = self._tick_ns
+        done, before = 0, run.point(0)
+        while done < run.ticks:
+            end = run.ticks
+            if self._earliest_due_ns > self._now_ns:
+                end = min(end, done - ((self._now_ns - self._earliest_due_ns) // tick_ns))
+            after = run.point(end)
+            self._commit(before, after, end - done)
+            published.extend(self._publish_due())
+            done, before = end, after
+        return published
+
+    def _commit(self, before: RunPoint, after: RunPoint, ticks: int) -> None:
+        """The state `ticks` ticks further along a run, from point `before` to `after`."""
+        move_along(self.state, before, after, self._wheel_radius_m, self._track_m)
+        self._clearance_m -= after.body_m - before.body_m
+        self._now_ns += ticks * self._tick_ns
+        # One call for the stretch: `advance` adds up over time (RobotModel.advance).
+        self.robot.advance(self.state, ticks * self._tick_s, self._now_ns / NS_PER_S)
 
     def _tick(self) -> None:
         dt = self._tick_s
@@ -339,8 +381,9 @@ class Simulation:
                 self._set_contact(False, (), x, y)
             return x, y
         angles: np.ndarray = np.zeros(0)
+        nearest: float | None = None  # [m] from the body's centre where it ends up
         for _ in range(_COLLISION_ITERATIONS):
-            push, touching = self.obstacles.penetrations(cx, cy, radius)
+            push, touching, nearest = self.obstacles.contacts(cx, cy, radius)
             if len(push) == 0:
                 break
             if len(angles) == 0:
@@ -350,9 +393,12 @@ class Simulation:
             deepest = int(np.argmax(np.hypot(push[:, 0], push[:, 1])))
             cx += float(push[deepest, 0])
             cy += float(push[deepest, 1])
+            nearest = None  # measured before this push
+        if nearest is None:
+            nearest = self.obstacles.clearance(cx, cy)
         x, y = cx - offset * math.cos(yaw), cy - offset * math.sin(yaw)
         # Margin of 0.5 mm so a robot resting against a wall keeps reporting the contact.
-        self._clearance_m = self.obstacles.clearance(cx, cy) - radius - 0.0005
+        self._clearance_m = nearest - radius - 0.0005
         robot_frame = tuple(wrap_angle(float(a) - self.state.pose.yaw) for a in angles)
         self._set_contact(len(angles) > 0, robot_frame, x, y)
         return x, y

@@ -15,18 +15,18 @@ import os
 from collections.abc import Iterator
 from pathlib import Path
 
-from sqlalchemy import Engine, create_engine, event, inspect
+from sqlalchemy import Engine, create_engine, event, inspect, text
 from sqlalchemy.engine import make_url
 from sqlalchemy.exc import ArgumentError, OperationalError
 from sqlalchemy.orm import Session, sessionmaker
 
+from server.store.errors import StoreError
+
 MIGRATIONS_DIR = Path(__file__).resolve().parent / "migrations"
 SQLITE_BUSY_TIMEOUT_MS = 10_000  # [ms] a writer waits this long for another before failing
+MIGRATION_LOCK = 0x526F626F446F6A6F  # PostgreSQL advisory lock key ("RoboDojo") around migrations
+ADMISSION_LOCK = 0x526F626F52756E73  # PostgreSQL advisory lock key ("RoboRuns") around admission
 POOL_SIZE = 10  # PostgreSQL connections kept open (FastAPI's thread pool is 40 by default)
-
-
-class StoreError(RuntimeError):
-    """The store cannot be opened or migrated; the message says what to fix."""
 
 
 def normalise_url(url: str) -> str:
@@ -80,6 +80,10 @@ def migrate(engine: Engine) -> None:
     config = Config()
     config.set_main_option("script_location", str(MIGRATIONS_DIR))
     with engine.begin() as connection:
+        if engine.dialect.name == "postgresql":
+            # Several processes of a cluster may start at once on a new database: one migrates,
+            # the others wait here (until its transaction ends) and then find nothing to do.
+            connection.execute(text("SELECT pg_advisory_xact_lock(:key)"), {"key": MIGRATION_LOCK})
         config.attributes["connection"] = connection
         command.upgrade(config, "head")
 
@@ -134,6 +138,20 @@ class Store:
             raise
         finally:
             session.close()
+
+    @contextlib.contextmanager
+    def exclusive_session(self, lock: int = ADMISSION_LOCK) -> Iterator[Session]:
+        """A session holding a database-wide write lock from its first statement to its commit,
+        for a count-then-insert that two processes must not interleave (run admission: two web
+        processes each counting a student's runs before either stored one would let both in).
+        PostgreSQL: the transaction-scoped advisory lock `lock`; SQLite: BEGIN IMMEDIATE, the
+        database's one write lock (`lock` is moot), waited for up to the busy timeout."""
+        with self.session() as session:
+            if self.dialect == "postgresql":
+                session.execute(text("SELECT pg_advisory_xact_lock(:lock)"), {"lock": lock})
+            else:  # Python's sqlite3 begins on the first write; take the write lock now
+                session.connection().exec_driver_sql("BEGIN IMMEDIATE")
+            yield session
 
     @property
     def dialect(self) -> str:

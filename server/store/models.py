@@ -150,6 +150,8 @@ class RunRecord(Base):
     # A hardware run: the simulation run of the same code that passed its gate, for the
     # sim-vs-real comparison (server/service/comparison.py). None for simulation runs.
     simulation_run_id: Mapped[str | None] = mapped_column(String(ID_LENGTH), nullable=True)
+    # The worker executing the run ("host:pid", issue 16), set when it starts; None before.
+    worker_id: Mapped[str | None] = mapped_column(String(128), nullable=True, index=True)
 
 
 class LabSetting(Base):
@@ -198,3 +200,21 @@ class LeaderboardSetting(Base):
     # Runs created before this (epoch [s]) do not count; None: never reset.
     reset_at: Mapped[float | None] = mapped_column(Float, nullable=True)
     updated_at: Mapped[float] = mapped_column(Float)
+
+
+class WorkerRecord(Base):
+    """A worker process of the cluster (`robodojo worker`), as it last reported itself. Its
+    `last_seen` is renewed every few seconds; one unseen for longer is lost, and its runs end
+    "failed: worker lost" (server/store/workers.py)."""
+
+    __tablename__ = "workers"
+
+    id: Mapped[str] = mapped_column(String(128), primary_key=True)  # host:pid
+    host: Mapped[str] = mapped_column(String(128))
+    capacity: Mapped[int] = mapped_column(Integer)  # runs it takes at once
+    running: Mapped[int] = mapped_column(Integer)  # runs it holds now
+    state: Mapped[str] = mapped_column(String(16))  # WorkerState
+    message: Mapped[str] = mapped_column(Text, default="")  # why it is not "ready", a sentence
+    robots: Mapped[list] = mapped_column(JSON, default=list)  # bench robots it holds
+    started_at: Mapped[float] = mapped_column(Float)
+    last_seen: Mapped[float] = mapped_column(Float, index=True)

@@ -114,6 +114,47 @@ def active_count(db: Db, user_id: str | None = None) -> int:
     return db.scalar(query) or 0
 
 
+def claim(db: Db, run_id: str, worker_id: str) -> bool:
+    """A worker takes a queued run: True only for the one whose update found it still "created"
+    (a job delivered twice, or to a worker after the run was stopped, is not run again)."""
+    result = db.execute(
+        update(RunRecord)
+        .where(RunRecord.id == run_id, RunRecord.state == str(RunState.CREATED))
+        .values(state=str(RunState.STARTING), worker_id=worker_id)
+    )
+    return (result.rowcount or 0) == 1
+
+
+def end_queued(db: Db, run_id: str, state: str, reason: str) -> bool:
+    """End a run no worker has claimed yet (stopped while queued); False when it was claimed."""
+    result = db.execute(
+        update(RunRecord)
+        .where(RunRecord.id == run_id, RunRecord.state == str(RunState.CREATED))
+        .values(state=state, reason=reason, ended_at=time.time())
+    )
+    return (result.rowcount or 0) == 1
+
+
+def end_if_active(db: Db, run_id: str, state: str, reason: str) -> bool:
+    """End a run that has not ended yet (a later end never overwrites the first one)."""
+    result = db.execute(
+        update(RunRecord)
+        .where(RunRecord.id == run_id, RunRecord.state.in_(ACTIVE_STATES))
+        .values(state=state, reason=reason, ended_at=time.time())
+    )
+    return (result.rowcount or 0) == 1
+
+
+def queued_before(db: Db, cutoff: float, limit: int = MAX_LISTED) -> list[str]:
+    """Runs still waiting for a worker ("created") that were made before `cutoff` [epoch s]."""
+    query = (
+        select(RunRecord.id)
+        .where(RunRecord.state == str(RunState.CREATED), RunRecord.created_at < cutoff)
+        .limit(limit)
+    )
+    return list(db.scalars(query))
+
+
 def mark_interrupted(db: Db) -> int:
     """At start-up: every run still marked active was cut off by the last stop."""
     result = db.execute(

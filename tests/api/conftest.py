@@ -115,8 +115,13 @@ class LabServer:
 
 
 def start_server(
-    data: Path, env_extra: dict[str, str] | None = None, port: int | None = None
+    data: Path,
+    env_extra: dict[str, str] | None = None,
+    port: int | None = None,
+    own_session: bool = False,
 ) -> LabServer:
+    """`own_session`: the server leads a session and process group of its own, as under a
+    service manager, so a test can signal the whole group (os.killpg(process.pid, ...))."""
     port = port or free_port()
     env = dict(os.environ)
     # Several test servers run at once: each takes any free rosserial port, on loopback only
@@ -127,13 +132,24 @@ def start_server(
             "PYTHONUNBUFFERED": "1",
             "ROBODOJO_ROSSERIAL_PORT": "0",
             "ROBODOJO_ROSSERIAL_HOST": "127.0.0.1",
+            # One editor analysis worker (a process that reads numpy and rospy for a while at
+            # start): tests/api/test_editor.py needs one, the other servers need no more.
+            "ROBODOJO_EDITOR_WORKERS": "1",
+            # Runs in the server's own threads: quicker to start; the per-core default (worker
+            # processes) has tests/workers/test_local_processes.py.
+            "ROBODOJO_WORKERS": "0",
         }
     )
     env.update(env_extra or {})
     command = [sys.executable, "-m", "server.cli", "serve", "--port", str(port), "--data",
                str(data)]  # fmt: skip
     process = subprocess.Popen(
-        command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env
+        command,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        env=env,
+        start_new_session=own_session,
     )
     output: list[str] = []
     found: dict[str, str] = {}

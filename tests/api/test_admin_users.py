@@ -95,6 +95,9 @@ def test_admin_run_filters_and_status(lab):
     assert bad.status_code == 422 and "query.state" in bad.json()["detail"]
     status = admin.get("/api/admin/status").json()
     assert status["runs"]["max_runs_total"] >= 1
+    (web,) = status["runs"]["workers"]  # --workers 0: the web process runs every run
+    assert web["role"] == "web process: every run"
+    assert web["capacity"] == status["runs"]["max_runs_total"]
     assert status["server"]["rss_mib"] > 10
     assert status["database"] in ("sqlite", "postgresql")
     assert status["machine"]["cpus"] >= 1

@@ -5,9 +5,12 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import os
+import signal
 import subprocess
 import sys
 
+import psutil
 import pytest
 
 from server.exercises.grading import grade, reference_nodes, starter_nodes
@@ -18,6 +21,7 @@ from server.exercises.registry import (
     validate_exercise,
 )
 from server.runs.state import RunState
+from tests.waiting import wait_until
 
 FIVE_SEEDS = (1, 2, 3, 4, 5)
 # The fast set (-m "not slow") grades one quick starter; the rest take seconds each.
@@ -43,6 +47,13 @@ def test_a_leaderboard_check_that_is_no_check_is_refused():
     assert "settling_time" in problems[0]  # the checks it could name
 
 
+def test_a_check_that_cannot_reach_a_worker_process_is_refused():
+    exercise = get_exercise("crowbot_distance_pid")
+    closure = dataclasses.replace(exercise.checks[0], metric=lambda evidence: 0.0)
+    problems = validate_exercise(dataclasses.replace(exercise, checks=(closure,)))
+    assert len(problems) == 1 and "module-level function, not a lambda" in problems[0]
+
+
 def test_unknown_exercise_lists_the_valid_ids():
     with pytest.raises(UnknownExerciseError, match="crowbot_distance_pid"):
         get_exercise("crowbot_distnce_pid")
@@ -50,9 +61,9 @@ def test_unknown_exercise_lists_the_valid_ids():
 
 @pytest.mark.slow
 @pytest.mark.parametrize("exercise_id", exercise_ids())
-def test_reference_passes_on_five_seeds(exercise_id, launcher, tmp_path):
+def test_reference_passes_on_five_seeds(exercise_id, tmp_path):
     exercise = dataclasses.replace(get_exercise(exercise_id), seeds=FIVE_SEEDS)
-    result = grade(exercise, reference_nodes(exercise), launcher, tmp_path)
+    result = grade(exercise, reference_nodes(exercise), None, tmp_path)  # as robodojo check does
     failed = [(c.name, c.per_seed, c.threshold) for c in result.checks if not c.passed]
     assert result.passed, (failed, [r["reason"] for r in result.runs])
 
@@ -82,3 +93,28 @@ def test_check_command_grades_and_sets_the_exit_code(tmp_path):
     nothing = subprocess.run(command, capture_output=True, text=True, timeout=60)
     assert nothing.returncode == 2
     assert "--node FILE [...], --reference or --starter" in nothing.stderr
+
+
+@pytest.mark.slow
+def test_check_interrupted_from_the_keyboard_says_so_and_leaves_no_process():
+    command = [sys.executable, "-m", "server.cli", "check", "crop_row_fuzzy", "--reference"]
+    check = subprocess.Popen(
+        command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True
+    )
+    cli = psutil.Process(check.pid)
+    workers = wait_until(
+        lambda: [p for p in cli.children() if "server.cli" in " ".join(p.cmdline())],
+        60,
+        "the check's worker processes started",
+    )
+    wait_until(
+        lambda: any(worker.children() for worker in workers), 60, "a worker started its nodes"
+    )
+    os.killpg(check.pid, signal.SIGINT)  # Ctrl-C in a terminal: the whole process group
+    out, err = check.communicate(timeout=60)
+    assert check.returncode == 1, err
+    assert err.strip().splitlines()[-1] == (
+        "robodojo: check interrupted from the keyboard; no grade"
+    )
+    assert "Traceback" not in err and out == ""
+    wait_until(lambda: not any(w.is_running() for w in workers), 30, "the workers ended")

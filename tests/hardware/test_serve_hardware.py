@@ -53,7 +53,9 @@ def add_bench_exercise(admin, exercise_id: str, duration_s: float) -> dict:
 
 @pytest.fixture(scope="module")
 def bench(tmp_path_factory) -> Iterator[tuple[LabServer, CrowBotFirmware]]:
-    server = start_server(tmp_path_factory.mktemp("bench"))
+    # The lab's default (issue 16): simulation runs on worker processes, while the robot's runs
+    # stay in the web process holding its connection (the other servers here run in-process).
+    server = start_server(tmp_path_factory.mktemp("bench"), {"ROBODOJO_WORKERS": "2"})
     admin = server.admin()
     port = admin.get("/api/admin/status").json()["hardware"]["rosserial_port"]
     made = admin.post(

@@ -155,8 +155,9 @@ def test_latest_value_wins_and_only_it_is_kept() -> None:
         telemetry = RunTelemetry("r3")
         viewer = telemetry.viewer()
         viewer.subscribe("count", max_rate_hz=60)
-        for i in range(1000):
+        for i in range(999):
             telemetry.on_message("count", INT32, i, int32(i))
+        telemetry.on_message("count", INT32, 999, int32(999), produced_wall_s=1234.5)
         assert len(telemetry._latest) == 1  # one sample per topic, however many arrive
         frames = await viewer.next_frames(timeout_s=1.0)
         sample = [frame for frame in frames if frame["type"] == "telemetry"]
@@ -168,8 +169,24 @@ def test_latest_value_wins_and_only_it_is_kept() -> None:
                 "time_s": 999e-9,
                 "msg": {"data": 999},
                 "dropped": 999,
+                "wall_s": 1234.5,  # a mirror's production time, passed through
             }
         ]
+
+    asyncio.run(main())
+
+
+def test_a_frame_carries_when_the_run_produced_its_sample() -> None:
+    async def main() -> None:
+        telemetry = RunTelemetry("r3b")
+        viewer = telemetry.viewer()
+        viewer.subscribe("count", max_rate_hz=60)
+        before_s = time.time()
+        telemetry.on_message("count", INT32, 0, int32(0))
+        after_s = time.time()
+        frames = await viewer.next_frames(timeout_s=1.0)
+        (frame,) = [frame for frame in frames if frame["type"] == "telemetry"]
+        assert before_s <= frame["wall_s"] <= after_s, "stamped when the run handed it over"
 
     asyncio.run(main())
 

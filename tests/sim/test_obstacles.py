@@ -245,7 +245,7 @@ def test_few_ray_cast_with_circles_and_heights() -> None:
         np.testing.assert_allclose(few.distance_m, dense.distance_m, atol=1e-12)
 
 
-@pytest.mark.parametrize("world_id", ["wall_approach", "obstacle_maze", "office"])
+@pytest.mark.parametrize("world_id", ["wall_approach", "obstacle_maze", "office", "crop_rows"])
 def test_contact_queries_agree_between_python_and_numpy(world_id: str) -> None:
     fast = Obstacles(load_world(world_id))
     batched = Obstacles(load_world(world_id))
@@ -260,3 +260,12 @@ def test_contact_queries_agree_between_python_and_numpy(world_id: str) -> None:
         np.testing.assert_allclose(push_fast, push_numpy, atol=1e-12)
         # Compare directions, not numbers: -pi and pi are the same way (a signed zero apart).
         np.testing.assert_allclose(np.angle(np.exp(1j * (angle_fast - angle_numpy))), 0, atol=1e-9)
+        # One pass gives both answers, each path the same as its own two queries.
+        for obstacles, push, angle in (
+            (fast, push_fast, angle_fast),
+            (batched, push_numpy, angle_numpy),
+        ):
+            both_push, both_angle, nearest = obstacles.contacts(x, y, radius)
+            np.testing.assert_array_equal(both_push, push)
+            np.testing.assert_array_equal(both_angle, angle)
+            assert nearest == obstacles.clearance(x, y)

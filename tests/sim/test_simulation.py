@@ -89,7 +89,12 @@ def test_many_small_steps_equal_one_big_step():
     big = a.step(1.0)
     small = [item for _ in range(400) for item in b.step(0.0025)]
     assert [(p.topic, p.time_s) for p in big] == [(p.topic, p.time_s) for p in small]
-    assert (a.state.pose.x, a.state.pose.y) == (b.state.pose.x, b.state.pose.y)
+    assert [p.message.serialize() for p in big] == [p.message.serialize() for p in small]
+    # The same ticks; a big step evaluates them in runs (server/sim/tick_runs.py), small ones
+    # one by one, so the sums round differently in the last bits.
+    assert (a.state.pose.x, a.state.pose.y) == pytest.approx(
+        (b.state.pose.x, b.state.pose.y), abs=1e-12
+    )
 
 
 def _stream(robot: str, world: str, seed: int, command: tuple[str, object]) -> list[bytes]:

@@ -3,7 +3,8 @@
 Server -> client frames (JSON):
     {"type": "snapshot", "run_id", "state", "reason", "time_s", "topics": {name: type}}
     {"type": "topic", "topic", "msg_type"}                      a topic's first message
-    {"type": "telemetry", "topic", "msg_type", "time_s", "msg": {...}, "dropped": n}
+    {"type": "telemetry", "topic", "msg_type", "time_s", "msg": {...}, "dropped": n,
+     "wall_s"}                        wall_s: time.time() when the run produced the sample
     {"type": "log", "node", "line"} / {"type": "state", "state", "reason", "time_s"}
     {"type": "checks", "checks": [...], "score"}                                 exercises
     {"type": "dropped", "what": "events", "count": n}                            fell behind
@@ -40,7 +41,12 @@ from server.api.auth import foreign_origin, websocket_user
 from server.api.live_ops import LiveContext, apply_live
 from server.api.sockets import REVOKED_CODE, REVOKED_REASON
 from server.runs.commands import CommandError
-from server.service.telemetry import SubscriptionError, UnknownRunError, ViewerLimitError
+from server.service.telemetry import (
+    KEEP_AFTER_END_S,
+    SubscriptionError,
+    UnknownRunError,
+    ViewerLimitError,
+)
 from server.store import runs as run_store
 
 router = APIRouter()
@@ -79,7 +85,13 @@ async def live(websocket: WebSocket, run_id: str) -> None:
         return
     service = app.state.runs
     try:
-        telemetry = service.telemetry.get(run_id)
+        # In a cluster the first look may wait for Redis and the database: off the loop.
+        telemetry = await run_in_threadpool(service.feed, run_id)
+        if telemetry is None:
+            raise UnknownRunError(
+                f"run {run_id} has no live telemetry: it is not running or ended more than "
+                f"{KEEP_AFTER_END_S:g} s ago; its recording has the data"
+            )
         viewer = telemetry.viewer()
     except (UnknownRunError, ViewerLimitError) as error:
         # Ended long ago (or too many viewers): what the store knows, then the end.

@@ -198,6 +198,7 @@ def create(body: RunCreate, request: Request, caller: Caller = Depends(current_u
         clock=Clock(body.clock) if body.clock else None,
         duration_s=body.duration,
         seed=body.seed,
+        case=body.case,
         params=dict(plan.params) if plan else {},
         files=files,
     )

@@ -110,7 +110,10 @@ class RobotModel:
         return self.frames
 
     def advance(self, state: RobotState, dt_s: float, time_s: float) -> None:
-        """Per physics tick, for actuators other than the wheels (servo slew, buzzer timer)."""
+        """For actuators other than the wheels (servo slew, buzzer timer): once per tick, or
+        once for a run of ticks with `dt_s` their sum and `time_s` the last one's end
+        (server/sim/tick_runs.py). So it must add up over time: one call with dt_a + dt_b
+        leaves the state two calls with dt_a and dt_b would."""
         if state.buzzer_on and time_s >= state.buzzer_until_s:
             state.buzzer_on = False
 

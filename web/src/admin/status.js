@@ -35,6 +35,22 @@ function hardwareCard(hw) {
   );
 }
 
+// Where runs execute: each worker process (or cluster worker) with its load, and the web
+// process itself when it runs some (every run with --workers 0; real robots' runs beside worker
+// processes, with no capacity of its own: a robot takes one run at a time).
+function workersCard(workers) {
+  if (!workers || !workers.length) return null;
+  const pools = workers.filter((w) => w.capacity != null);
+  const capacity = pools.reduce((n, w) => n + w.capacity, 0);
+  const running = workers.reduce((n, w) => n + (w.running || 0), 0);
+  const lines = workers.map((w) => {
+    const load = w.capacity == null ? `${w.running} running` : `${w.running}/${w.capacity} running`;
+    const warm = w.warm == null ? "" : `, ${w.warm} warm`;
+    return `${w.role || "worker"} ${w.id}: ${load}${warm}, ${w.state}`;
+  });
+  return card("Workers", `${running}/${capacity} runs`, ...lines);
+}
+
 function mib(bytes) {
   return bytes == null ? "?" : `${(bytes / 2 ** 20).toFixed(1)} MiB`;
 }
@@ -93,6 +109,7 @@ function render(s) {
       `${machine.memory_available_mib ?? "?"} MiB available`,
       `server process: ${server.rss_mib ?? "?"} MiB resident`,
     ),
+    workersCard(runs.workers),
     diskCard(s.disk),
     hardwareCard(s.hardware),
     card(

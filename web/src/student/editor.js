@@ -4,18 +4,14 @@
 // file; "+ File" adds a data file (CSV, YAML, JSON, TXT, a launch file), empty or uploaded,
 // edited as text; a file the student added (not the exercise's starter) can be deleted with its
 // versions (the tab's x, or Delete on the tab). A run opened by its id (app.watching) shows that run's code
-// read-only instead of a workspace.
+// read-only instead of a workspace. A Python file gets the server's help as it is typed
+// (assist.js: diagnostics, completion, signature help, hover, format); every editor's colours
+// follow the system's light or dark preference (theme.js).
 
 import { closeBrackets, closeBracketsKeymap } from "@codemirror/autocomplete";
 import { defaultKeymap, history, historyKeymap, indentWithTab } from "@codemirror/commands";
 import { python } from "@codemirror/lang-python";
-import {
-  bracketMatching,
-  defaultHighlightStyle,
-  indentOnInput,
-  indentUnit,
-  syntaxHighlighting,
-} from "@codemirror/language";
+import { bracketMatching, indentOnInput, indentUnit } from "@codemirror/language";
 import { highlightSelectionMatches, search, searchKeymap } from "@codemirror/search";
 import { EditorState, Prec } from "@codemirror/state";
 import {
@@ -30,7 +26,9 @@ import {
 } from "@codemirror/view";
 import { api } from "../common/api.js";
 import { byId, debounce, fill, h, when } from "../common/dom.js";
+import { assistExtensions, formatAndReport, inertCompletion } from "./assist.js";
 import { app, emit, fileOf, isLaunchFile, isNodeFile, nodeOf, on } from "./state.js";
+import { systemTheme } from "./theme.js";
 
 const AUTOSAVE_MS = 1200; // [ms] after the last keystroke; each save is a version on the server
 const MAX_NODES = 8; // the API's limit of nodes in one run
@@ -44,6 +42,8 @@ const tabsElement = byId("file-tabs");
 const statusElement = byId("save-status");
 const addButton = byId("add-node");
 const versionsButton = byId("versions-button");
+const formatButton = byId("format-button");
+const formatStatus = byId("format-status");
 let view = null;
 let workspace = null; // the workspace the files below belong to (null: a run's code, read-only)
 let readOnly = false;
@@ -61,7 +61,7 @@ export function pythonExtensions({ readOnly = false, label = "Python code" } = {
     highlightSpecialChars(),
     drawSelection(),
     indentUnit.of("    "),
-    syntaxHighlighting(defaultHighlightStyle, { fallback: true }),
+    systemTheme(),
     bracketMatching(),
     highlightSelectionMatches(),
     python(),
@@ -78,6 +78,7 @@ function textExtensions({ readOnly = false, label }) {
     highlightSpecialChars(),
     drawSelection(),
     indentUnit.of("  "),
+    systemTheme(),
     highlightSelectionMatches(),
     EditorState.readOnly.of(readOnly),
     EditorView.contentAttributes.of(readOnly ? { "aria-label": label, "aria-readonly": "true" } : { "aria-label": label }),
@@ -91,6 +92,7 @@ function fileExtensions(filename, { readOnly: locked = false } = {}) {
       language({ readOnly: true, label: `Code of ${filename} in the run on show (read only)` }),
       search({ top: true }),
       keymap.of([...defaultKeymap, ...searchKeymap]),
+      inertCompletion,
     ];
   }
   return [
@@ -112,6 +114,7 @@ function fileExtensions(filename, { readOnly: locked = false } = {}) {
     EditorView.updateListener.of((update) => {
       if (update.docChanged) edited(filename);
     }),
+    filename.endsWith(".py") ? assistExtensions({ filename, report: showFormatOutcome }) : inertCompletion,
   ];
 }
 
@@ -119,7 +122,7 @@ export function initEditor({ run }) {
   onRun = run;
   view = new EditorView({
     parent: byId("editor"),
-    state: EditorState.create({ doc: "# loading…", extensions: pythonExtensions({ readOnly: true }) }),
+    state: EditorState.create({ doc: "# loading…", extensions: [pythonExtensions({ readOnly: true }), inertCompletion] }),
   });
   on("target", ({ changedWorkspace }) => {
     if (app.watching) showRunCode(app.watching);
@@ -132,6 +135,9 @@ export function initEditor({ run }) {
     if (!cross) return;
     event.stopPropagation();
     confirmDelete(cross.dataset.file);
+  });
+  formatButton.addEventListener("click", () => {
+    if (current?.endsWith(".py") && !readOnly) formatAndReport(view, current, showFormatOutcome);
   });
   initAddNode();
   initAddFile();
@@ -319,12 +325,14 @@ function show(filename) {
   view.setState(files.get(filename).state);
   renderTabs();
   showStatus();
+  formatButton.disabled = readOnly || !filename.endsWith(".py"); // Python only, never a run's code
   emit("file-shown", { filename });
 }
 
 function edited(filename) {
   const file = files.get(filename);
   if (!file) return;
+  formatStatus.textContent = ""; // a format's outcome is about the text before this edit
   file.edited = true;
   file.error = null;
   file.autosave();
@@ -392,6 +400,12 @@ function showStatus() {
   if (file.savedCode === null && !file.edited) return setStatus("Starter code");
   if (code(file) !== file.savedCode) return setStatus("Unsaved changes");
   setStatus(`Saved v${file.version}${file.savedAt ? ` at ${when(file.savedAt)}` : ""}`);
+}
+
+/** "Formatted.", or why not (a syntax error's line), beside the Format button until the next edit. */
+function showFormatOutcome(text, error) {
+  formatStatus.textContent = text;
+  formatStatus.classList.toggle("error", error);
 }
 
 function setStatus(text, error = false) {

@@ -6,6 +6,7 @@ import { api } from "../common/api.js";
 import { byId, fill, h, when } from "../common/dom.js";
 import { tabs } from "../common/tabs.js";
 import { initCatalog, leaveWatch } from "./catalog.js";
+import { initCheck } from "./check.js";
 import { initCompare } from "./compare.js";
 import { initConsole } from "./console.js";
 import { initEditor } from "./editor.js";
@@ -171,6 +172,7 @@ async function boot() {
   initEditor({ run: start });
   initVersions();
   initRunner();
+  initCheck();
   initEstop();
   initHardware();
   initConsole();

@@ -88,7 +88,20 @@ function fillWhat() {
 
 /** Whether a run on show is going (a new one cannot start meanwhile). */
 export function runGoing() {
-  return starting || (Boolean(app.live) && !END_STATES.has(state));
+  return starting || Boolean(app.checking) || (Boolean(app.live) && !END_STATES.has(state));
+}
+
+/** The body of POST /api/runs for a check of the editor's nodes, every edit saved first (the
+ * server reads launch and data files from the workspace). */
+export async function checkBody() {
+  if (!form.reportValidity()) throw new Error("fix the run settings first");
+  await flushAll();
+  return runBody();
+}
+
+/** Redraw the run controls (a check started or ended: runs wait for it). */
+export function refreshControls() {
+  controls();
 }
 
 /** The body of POST /api/runs for the editor's nodes and the target. */
@@ -328,7 +341,7 @@ function progressOf(run) {
 function controls() {
   const active = Boolean(app.live) && !END_STATES.has(state);
   emit("run-controls", { going: starting || active });
-  runButton.disabled = starting || active || Boolean(app.watching);
+  runButton.disabled = starting || active || Boolean(app.watching) || Boolean(app.checking);
   runButton.textContent = starting ? "Starting…" : "▶ Run in simulation";
   stopButton.disabled = !active;
   const lockstep = app.run?.clock === "lockstep";
