@@ -87,6 +87,9 @@ class RobotLink(Protocol):
     # Optional: `publishes` (a collection of topic names the robot sends). A link that has it
     # has those topics watched for silence from the start of a run; one without it has each
     # topic watched from its first message.
+    # Optional: `listened_until_s` (monotonic [s], or None): everything the robot sent before it
+    # has reached take_received(). Silence is counted up to there, not up to now, so a reader
+    # thread a busy host did not schedule does not make a talking robot look silent.
 
 
 class _Bench:
@@ -210,6 +213,8 @@ class HardwareRobot:
         self._time_s += dt_s
         started = self._started_s if self._started_s is not None else self._clock()
         published = []
+        # Before take_received(): what arrived before this moment is in the inbox being taken.
+        listened_s = getattr(self.link, "listened_until_s", None)
         silence = self.silence
         if silence is None:
             silence = self.silence = SensorSilenceWatchdog({}, started, self.silence_limits)
@@ -221,7 +226,8 @@ class HardwareRobot:
                 silence.watch(topic, self._sensor_rates_hz[topic], received_s)
             silence.heard(topic, received_s)
         now = self._clock()
-        if (silent := silence.check(now)) is not None:
+        heard_until_s = now if listened_s is None else min(now, listened_s)
+        if (silent := silence.check(heard_until_s)) is not None:
             self._stop_wheels()
             raise RobotSilent(silent.sentence)
         if self.watchdog.expired(now) and not self._zero_sent:

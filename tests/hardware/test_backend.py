@@ -15,7 +15,7 @@ from sandbox.msgs import get_message_class
 from sandbox.msgs.geometry_msgs import Twist
 from sandbox.msgs.std_msgs import Int32
 from sandbox.protocol import Clock
-from server.hardware.backend import HardwareRobot
+from server.hardware.backend import HardwareRobot, RobotSilent
 from server.hardware.safety import MotionLimits
 from server.runs.run import Run
 from server.runs.spec import NodeSpec, RunSpec, RunSpecError
@@ -189,3 +189,54 @@ def test_a_real_robot_needs_the_realtime_clock(tmp_path, launcher, robot):
     with pytest.raises(RunSpecError, match="realtime"):
         Run(spec(DRIVER, clock=Clock.LOCKSTEP), launcher, tmp_path / "run",
             backend=HardwareRobot("crowbot", robot, LIMITS))  # fmt: skip
+
+
+class _ReadLateLink:
+    """A link whose reader thread was not scheduled: it says how far it has read
+    (`listened_until_s`), and what the robot sent after that has not reached the inbox yet."""
+
+    connected = True
+    lost_reason = ""
+    publishes = frozenset({"Distance"})
+
+    def __init__(self) -> None:
+        self.listened_until_s: float | None = 0.0
+        self.inbox: list[tuple[str, object, float]] = []
+        self.sent: list[tuple[str, object]] = []
+
+    def send(self, topic: str, message: object) -> None:
+        self.sent.append((topic, message))
+
+    def take_received(self):
+        taken, self.inbox = self.inbox, []
+        return taken
+
+
+def test_silence_counts_only_as_far_as_the_host_has_read():
+    now = [0.0]
+    link = _ReadLateLink()
+    backend = HardwareRobot("crowbot", link, LIMITS, clock=lambda: now[0])
+    backend.reset()
+    link.inbox.append(("Distance", Int32(data=42), 0.1))
+    link.listened_until_s = 0.11
+    backend.step(0.1)
+    # The host's reader stalls for 1 s: the robot may have talked all along, unread.
+    now[0] = 1.1
+    backend.step(0.1)  # no RobotSilent: nothing is known past 0.11 s
+    link.sent.clear()  # (the command watchdog's zero: the node sent nothing for 0.5 s)
+    # The reader catches up and finds the robot did stop: 1.0 s of real silence.
+    link.listened_until_s = 1.1
+    with pytest.raises(RobotSilent, match=r"robot stopped sending Distance for 1\.0 s"):
+        backend.step(0.1)
+    assert link.sent[-1] == ("Control", Twist())  # the wheels were stopped
+
+
+def test_a_link_that_does_not_say_how_far_it_read_is_judged_by_the_clock():
+    now = [0.0]
+    link = _ReadLateLink()
+    link.listened_until_s = None
+    backend = HardwareRobot("crowbot", link, LIMITS, clock=lambda: now[0])
+    backend.reset()
+    now[0] = 0.4
+    with pytest.raises(RobotSilent, match=r"robot stopped sending Distance for 0\.4 s"):
+        backend.step(0.1)

@@ -302,6 +302,25 @@ def test_a_garbage_flood_keeps_memory_flat_and_the_good_robot_served() -> None:
         assert handler.connected[0].state is SessionState.READY
 
 
+def test_the_server_vouches_only_for_time_its_thread_was_reading() -> None:
+    """`listened_until_s` (the silence watchdog's horizon) trails the clock by a beat or two,
+    and does not move while the rosserial thread is kept from running: every Distance the
+    robot sent before it has been dispatched."""
+    handler = Recorder()
+    with serving(handler) as server, firmware(server):
+        assert wait_until(lambda: handler.count("robot-1", "Distance") >= 5)
+        assert wait_until(lambda: server.listened_until_s is not None)
+        assert time.monotonic() - server.listened_until_s < 0.5
+        blocked = time.monotonic()
+        server._call_on_loop(time.sleep, 0.4)  # a host too busy to schedule the thread
+        time.sleep(0.2)
+        assert server.listened_until_s < blocked + 0.05  # not vouched for while blocked
+        sent_by = time.monotonic()  # the firmware went on publishing meanwhile
+        assert wait_until(lambda: server.listened_until_s > sent_by)
+        seen = handler.count("robot-1", "Distance")
+        assert seen >= 5 + 4  # at 20 Hz, what came during the block was read before the beat
+
+
 def test_a_silent_connection_is_closed() -> None:
     handler = Recorder()
     with (

@@ -31,6 +31,7 @@ class RosserialLimits:
     idle_timeout_s: float
     request_topics_interval_s: float
     poll_interval_s: float
+    listen_beat_s: float
     handshake_timeout_s: float
     max_pending_per_address: int
     refusals_before_backoff: int
@@ -98,6 +99,10 @@ DEFAULT_LIMITS = RosserialLimits(
     request_topics_interval_s=1.0,
     # [s] how often timers (sync, silence, frame timeout) are checked for every connection.
     poll_interval_s=0.1,
+    # [s] how often the rosserial thread notes that it is listening (`listened_until_s`): a run's
+    # silence watchdog counts a robot silent only up to the last beat, so a host too busy to read
+    # its sockets does not blame the robot; 20 ms keeps the watchdog's 0.3 s bound within 40 ms.
+    listen_beat_s=0.02,
     # ---- admission (who gets a session at all; ros_lib has no authentication, see README)
     # [s] a connection that has not finished the rosserial handshake (topics advertised and
     # settled: READY) within this is closed, so sockets that connect and say nothing cannot hold

@@ -69,6 +69,12 @@ class RosserialLink:
             self.lose("robot disconnected")
             raise RobotLost("robot disconnected") from None
 
+    @property
+    def listened_until_s(self) -> float | None:
+        """[s] monotonic: everything the robot sent before this is in the inbox (None: not yet
+        known); the silence watchdog counts no further (server/hardware/backend.py)."""
+        return self.connection.listened_until_s
+
     def take_received(self) -> list[Received]:
         return self._inbox.take()
 

@@ -146,6 +146,11 @@ class RobotConnection:
         return self.session.state is not SessionState.CLOSED
 
     @property
+    def listened_until_s(self) -> float | None:
+        """[s] monotonic: what this robot sent before it has been read (RosserialServer)."""
+        return self._server.listened_until_s
+
+    @property
     def close_reason(self) -> str | None:
         """Why the session closed, as a sentence (None while connected)."""
         return self.session.close_reason
@@ -367,6 +372,10 @@ class RosserialServer:
         self._listener: asyncio.Server | None = None
         self._port: int | None = None
         self.handler_errors = 0
+        # [s] monotonic: every byte a robot sent before this has been read and dispatched (the
+        # rosserial thread's beat before last; `_beat`). None until the thread has beaten twice.
+        self.listened_until_s: float | None = None
+        self._last_beat_s: float | None = None
 
     # ------------------------------------------------------------------------ any thread
     @property
@@ -457,6 +466,7 @@ class RosserialServer:
             self._port = self._listener.sockets[0].getsockname()[1]
             logger.info("rosserial: listening on %s:%d", self.host, self._port)
             loop.call_later(self.limits.poll_interval_s, self._poll)
+            loop.call_soon(self._beat)
             started.set()
             loop.run_forever()
         finally:
@@ -518,6 +528,20 @@ class RosserialServer:
         loop = self._loop
         if loop is not None and loop.is_running():
             loop.call_later(self.limits.poll_interval_s, self._poll)
+
+    def _beat(self) -> None:
+        """Note how far the sockets have been read. This callback runs in a later turn of the
+        loop than the previous beat, after a select() that began once that beat was over, so
+        every byte that arrived before the previous beat has been read and dispatched by now.
+        A thread starved by a busy host beats late, and a run's silence watchdog
+        (server/hardware/backend.py) then does not count the robot silent past this time."""
+        now_s = time.monotonic()
+        if self._last_beat_s is not None:
+            self.listened_until_s = self._last_beat_s
+        self._last_beat_s = now_s
+        loop = self._loop
+        if loop is not None and loop.is_running():
+            loop.call_later(self.limits.listen_beat_s, self._beat)
 
     def _forget(self, robot: RobotConnection) -> None:
         self._robots.pop(robot.id, None)
