@@ -29,7 +29,8 @@ class RobotState:
     `pose` is the true pose (ground truth, what the 3D view draws); sensors add their own noise.
     `wheel_left_rad_s`/`wheel_right_rad_s` are the actual wheel speeds after the motor model,
     `linear_m_s`/`angular_rad_s` the body velocities they give. `in_contact` is True while the
-    body touches world geometry; `contact_count` counts contacts begun (rising edges);
+    body touches world geometry; `contact_count` counts contacts begun (rising edges; a touch
+    within 0.1 s of the last release continues it: simulation.CONTACT_DEBOUNCE_S);
     `contact_angles_rad` are the directions of the touching surfaces seen from the body centre,
     in the robot frame (0 = straight ahead, positive to the left), for bumpers.
     `odometry_pose` integrates the (slipping, miscalibrated) wheel odometry and drifts from `pose`.

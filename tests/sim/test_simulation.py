@@ -71,6 +71,25 @@ def test_wall_stops_the_robot_without_penetration_and_counts_one_contact():
     assert [event.kind for event in sim.drain_events()] == [EventKind.CONTACT_ENDED]
 
 
+def test_a_touch_right_after_a_release_continues_the_contact_and_a_new_approach_counts():
+    # Pushed against the wall while turning, the Roomba's disc leaves the wall and touches it
+    # again 95 ms later: one contact (simulation.CONTACT_DEBOUNCE_S), two raw touches.
+    sim = Simulation("turtlebot", "wall_approach", seed=0)
+    sim.apply("cmd_vel", twist(0.5))
+    sim.step(10.0)
+    sim.apply("cmd_vel", twist(0.3, 1.0))
+    sim.step(2.0)
+    kinds = [event.kind for event in sim.drain_events()]
+    assert kinds.count(EventKind.CONTACT_BEGAN) == 2 and EventKind.CONTACT_ENDED in kinds
+    assert sim.state.contact_count == 1
+    # Backing off for a second and driving in again is a contact of its own.
+    again = Simulation("crowbot", "wall_approach", seed=0)
+    for linear, seconds in ((0.1, 10.0), (-0.1, 1.0), (0.1, 3.0)):
+        again.apply("Control", twist(linear))
+        again.step(seconds)
+    assert again.state.in_contact and again.state.contact_count == 2
+
+
 def test_sensor_topics_publish_at_their_declared_rates_in_time_order():
     sim = Simulation("turtlebot", "office", seed=3)
     published = sim.step(2.0)
