@@ -35,6 +35,12 @@ CLUSTER_WORKERS = 2  # `robodojo worker` processes, one per core of this machine
 REDIS_START_TIMEOUT_S = 10.0  # [s] redis-server answering PING
 FORKSERVER = "multiprocessing.forkserver"  # in the command line of a forkserver and its children
 WORKER_START_S = 3.0  # [s] a worker's start before it takes jobs (it needs no address to poll)
+# A lab that has just started still warms up for tens of seconds (the editor's analysis workers
+# load jedi's view of rospy, rclpy and numpy: ~7 s of CPU each, one after the other); measuring
+# runs over that measures the start-up. Wait until the lab's processes use less than this...
+SETTLED_CORES = 0.1  # [cores] over one SETTLE_WINDOW_S
+SETTLE_WINDOW_S = 1.0  # [s]
+SETTLE_TIMEOUT_S = 120.0  # [s] ... or this long, then say so and go on
 
 
 @dataclass
@@ -148,7 +154,9 @@ def open_lab(
                 raise BenchError("this checkout's `robodojo serve` has no --workers option")
             web = start_web("the web process", data, env, extra)
             started.append(web)
-            yield Lab(mode, serve_workers, [web])
+            lab = Lab(mode, serve_workers, [web])
+            settle(lab)
+            yield lab
             return
         redis = start_redis()
         started.append(redis)
@@ -173,12 +181,30 @@ def open_lab(
         for worker in workers:
             if worker.process.poll() is not None:
                 raise BenchError(f"{worker.name} exited at start:\n{worker.tail()}")
-        yield Lab(mode, None, webs, workers, [redis], database)
+        lab = Lab(mode, None, webs, workers, [redis], database)
+        settle(lab)
+        yield lab
     finally:
         for lab_process in reversed(started):  # webs first, so runs stop before the workers
             stop(lab_process)
         if database is not None:
             drop_database(database)
+
+
+def settle(lab: Lab) -> None:
+    """Wait until the lab's own start-up work is over (see SETTLED_CORES); print how long."""
+    started = time.monotonic()
+    roots = [*lab.web_processes(), *(psutil.Process(w.pid) for w in lab.workers)]
+    while time.monotonic() - started < SETTLE_TIMEOUT_S:
+        before = tree_cpu_s(roots)
+        time.sleep(SETTLE_WINDOW_S)
+        after = tree_cpu_s(roots)
+        used_s = sum(after[pid] - before[pid] for pid in after if pid in before)
+        if used_s / SETTLE_WINDOW_S < SETTLED_CORES:
+            print(f"  the lab settled {time.monotonic() - started:.0f} s after it answered")
+            return
+    busy = used_s / SETTLE_WINDOW_S
+    print(f"  the lab still used {busy:.2f} cores after {SETTLE_TIMEOUT_S:.0f} s; measuring anyway")
 
 
 def start_redis() -> LabProcess:

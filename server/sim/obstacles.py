@@ -132,6 +132,13 @@ class Obstacles:
                 [self.segment_start, self.segment_vector, self.segment_normal, self.segment_height]
             ).tolist()
         ]
+        # (centre x, centre y, half length) [m] of each segment: `cast_small` leaves out those
+        # wholly out of reach.
+        self._few_segment_bounds = [
+            (seg.start_x + seg.edge_x / 2, seg.start_y + seg.edge_y / 2,
+             math.hypot(seg.edge_x, seg.edge_y) / 2)
+            for seg in self._few_segments
+        ]  # fmt: skip
         # Contact queries in plain Python pay off up to this many surfaces.
         self._few_surfaces = len(segments) + len(circles) <= _FEW_MAX_SURFACES
         self._few_circles = [
@@ -140,6 +147,35 @@ class Obstacles:
                 [self.circle_centre, self.circle_radius, self.circle_height]
             ).tolist()
         ]
+
+    def cast_small(
+        self, origin_x: float, origin_y: float, angles_rad: list[float], max_range_m: float
+    ) -> tuple[list[float], list[float]] | None:
+        """`cast` from one origin in plain Python lists, for a sensor that samples a few rays
+        often: per ray the distance (inf beyond `max_range_m`) and the cosine of the incidence
+        angle (nan where nothing is hit). None when the world is too large for the loop: use
+        `cast` then."""
+        surface_count = self.segment_height.size + self.circle_height.size
+        if len(angles_rad) * surface_count > _FEW_MAX_PAIRS:
+            return None
+        # A surface whose nearest point is beyond the range cannot give a reading (a ray meets it
+        # further still): leaving it out changes no result, in order, and skips most of a room.
+        hypot = math.hypot
+        reach_m = max_range_m + _RANGE_MARGIN_M  # rounding in the bound must not cut a hit
+        segments = [
+            segment
+            for segment, (centre_x, centre_y, half_length) in zip(
+                self._few_segments, self._few_segment_bounds, strict=True
+            )
+            if hypot(centre_x - origin_x, centre_y - origin_y) - half_length <= reach_m
+        ]
+        circles = [
+            circle
+            for circle in self._few_circles
+            if hypot(circle.x - origin_x, circle.y - origin_y) - math.sqrt(circle.radius_sq)
+            <= reach_m
+        ]
+        return cast_few(segments, circles, origin_x, origin_y, angles_rad, max_range_m, 0.0)
 
     def cast(
         self,

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from server.sim.obstacles import Obstacles, RayHits
+from server.sim.raycast_few import cast_few
 from server.sim.world import load_world
 from tests.sim.shapes import make_world
 
@@ -229,6 +230,43 @@ def test_few_ray_python_cast_matches_dense(world_id: str) -> None:
         np.testing.assert_allclose(
             few.incidence_rad[finite], dense.incidence_rad[finite], atol=1e-7
         )
+
+
+def test_the_small_cast_leaves_out_only_surfaces_out_of_reach() -> None:
+    """cast_small culls surfaces beyond the range before its loop; every reading equals the
+    loop over every surface, exactly, including hits just inside the range and rays that start
+    inside a cylinder."""
+    world = make_world(
+        segments=[(1.0, -1.0, 1.0, 1.0), (2.0, -0.5, 2.0, 0.5), (-3.0, -3.0, 3.0, -3.0)],
+        circles=[(0.0, 1.5, 0.3), (0.0, 0.0, 0.2), (4.0, 4.0, 0.5)],
+    )
+    obstacles = Obstacles(world)
+    rng = np.random.default_rng(5)
+    culled_any = False
+    for _ in range(2000):
+        origin = rng.uniform(-3.0, 3.0, 2)
+        angles = (rng.uniform(-math.pi, math.pi) + np.linspace(-0.13, 0.13, 7)).tolist()
+        max_range = float(rng.choice([0.5, 1.0, 2.0]))
+        small = obstacles.cast_small(float(origin[0]), float(origin[1]), angles, max_range)
+        whole = cast_few(
+            obstacles._few_segments, obstacles._few_circles, *origin.tolist(), angles,
+            max_range, 0.0,
+        )  # fmt: skip
+        assert small is not None
+        np.testing.assert_array_equal(small[0], whole[0])  # distances, bit for bit
+        np.testing.assert_array_equal(small[1], whole[1])  # cosines (nan where nothing)
+        culled_any |= any(
+            math.hypot(x - origin[0], y - origin[1]) - half > max_range
+            for x, y, half in obstacles._few_segment_bounds
+        )
+    assert culled_any  # the case the culling is for did occur
+
+
+def test_a_large_world_is_not_cast_small() -> None:
+    obstacles = Obstacles(load_world("obstacle_maze"))
+    surfaces = obstacles.segment_height.size + obstacles.circle_height.size
+    assert surfaces * 7 > 160
+    assert obstacles.cast_small(1.0, 1.0, [0.0] * 7, 2.0) is None
 
 
 def test_few_ray_cast_with_circles_and_heights() -> None:

@@ -45,10 +45,26 @@ class UltrasonicRanger(StatelessSensor):
         self.mount = mount
         self.rate_hz = rate_hz
         self._offsets = np.linspace(-CONE_FULL_ANGLE_RAD / 2, CONE_FULL_ANGLE_RAD / 2, CONE_RAYS)
+        self._offset_list = self._offsets.tolist()
 
     def range_m(self, ctx: SenseContext) -> float:
         """True range [m] to the answering surface, inf for no echo."""
         x, y, heading = self.mount.in_world(ctx.state.pose)
+        # A small world in plain Python (~4x cheaper than through numpy at 7 rays; the same
+        # arithmetic, so the same readings), else the batched cast.
+        small = ctx.obstacles.cast_small(
+            x, y, [heading + offset for offset in self._offset_list], MAX_RANGE_M
+        )
+        if small is not None:
+            nearest = min(
+                (
+                    distance
+                    for distance, cosine in zip(*small, strict=True)
+                    if math.acos(min(max(cosine, 0.0), 1.0)) <= SPECULAR_MISS_INCIDENCE_RAD
+                ),
+                default=math.inf,
+            )
+            return nearest if nearest >= MIN_RANGE_M else math.inf
         hits = ctx.obstacles.cast(np.array([x, y]), heading + self._offsets, MAX_RANGE_M)
         heard = hits.incidence_rad <= SPECULAR_MISS_INCIDENCE_RAD
         distances = np.where(heard, hits.distance_m, np.inf)
