@@ -70,7 +70,10 @@ ARTIFACTS_DIR = "artifacts"
 DEFAULT_MAX_BUFFER_BYTES = 64 * 1024 * 1024  # [B] ~35k LiDAR scans: only a stalled disk gets here
 _ENTRY_OVERHEAD_BYTES = 128  # [B] a tuple + int + topic ref in CPython; bounds tiny messages too
 _WRITER_WAKE_BYTES = 1024 * 1024  # [B] wake the writer early once this much waits (one chunk)
-_WRITER_POLL_S = 0.05  # [s] otherwise the writer drains what has gathered every 50 ms
+# [s] otherwise the writer drains what has gathered this often. Each wake takes the GIL from
+# the realtime scheduler: at 50 ms, fifty runs' writers woke a worker 1,000 times a second
+# (a tenth of its interpreter time, issue 16); a quarter second of messages is a few kB.
+_WRITER_POLL_S = 0.25
 CHUNK_FLUSH_S = 1.0  # [s] chunks are closed at least this often: what a crash can lose
 _CLOSE_TIMEOUT_S = 60.0  # [s] a writer that cannot finish in this long is declared failed
 
