@@ -30,7 +30,7 @@ from contextlib import ExitStack
 from typing import ClassVar, Protocol
 
 from sandbox import ros2_imports, ros_imports, runtime
-from sandbox.after_import import AfterImport, BeforeImport
+from sandbox.after_import import AfterImport, BeforeImport, DeferredImport
 from sandbox.artifacts import collect_artifacts, write_workspace_files
 from sandbox.limits import DEFAULT_LIMITS, Limits
 from sandbox.protocol import Api, Clock, Exited, Load, NodeError, Outcome
@@ -210,6 +210,24 @@ def _note_heavy_imports(stack: ExitStack, node: NodeRuntime) -> None:
     stack.callback(hook.remove)
 
 
+def _defer_pyplot(stack: ExitStack) -> None:
+    """In a node started cold, `import matplotlib.pyplot` binds the module and runs its code at
+    its first use (sandbox/after_import.py): scikit-fuzzy imports pyplot for its visualizer
+    alone, ~0.25 s of CPU at every start of a fuzzy controller that never draws. The step that
+    first uses pyplot has its clock stopped while pyplot loads (NodeRuntime.library_loading),
+    so it keeps its budget for the rest, as the import in an earlier step left it."""
+    hook = DeferredImport("matplotlib.pyplot", _library_loading)
+    hook.install()
+    stack.callback(hook.remove)
+
+
+def _library_loading() -> contextlib.AbstractContextManager[object]:
+    """Through the node running now, if any (pyplot may be used first by a later node of the
+    same process, or after the node: the tests run many in one)."""
+    node = runtime.active()
+    return node.library_loading() if node is not None else contextlib.nullcontext()
+
+
 def _environment(stack: ExitStack, node: NodeRuntime, load: Load, workdir: str) -> None:
     """Point the interpreter at this node; every change is undone when `stack` closes."""
     install_ros_compat(load.info.ros_version)
@@ -237,6 +255,7 @@ def _environment(stack: ExitStack, node: NodeRuntime, load: Load, workdir: str) 
     _install_logging(stack, node)
     _note_figure_saving(stack, node)
     _note_heavy_imports(stack, node)
+    _defer_pyplot(stack)
     lockstep = load.info.clock is Clock.LOCKSTEP
     stack.callback(TimePatch(node.clock, node.sleep_for, node.poll, clocks=lockstep).remove)
     runtime.activate(node)

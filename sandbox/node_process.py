@@ -36,6 +36,7 @@ from sandbox.protocol import (
     FrameReader,
     FrameWriter,
     GraphTopic,
+    LibraryLoading,
     Load,
     NodeInfo,
     Outcome,
@@ -154,6 +155,9 @@ class NodeProcess:
         self._poller.register(from_child_r, select.POLLIN)
         self._poller.register(log_r, select.POLLIN)
         self._proto_open = self._log_open = True
+        # While a library loads (protocol.LibraryLoading): the step's time left [s], its budget
+        # [s] and its name, given back when the load is done.
+        self._paused: tuple[float, float, str] | None = None
 
     # ----------------------------------------------------------------------------- state
     def _move(self, new: NodeState) -> None:
@@ -229,12 +233,12 @@ class NodeProcess:
         while True:
             until = self._deadline if give_up is None else min(self._deadline, give_up)
             reply = self._receive_until(until)
-            if not isinstance(reply, Drawing):
+            if isinstance(reply, Drawing):
+                self._drawing()
+            elif isinstance(reply, LibraryLoading):
+                self._library_loading(reply.done)
+            else:
                 break
-            # Saving a figure may take seconds: this step gets the end budget instead.
-            self._expect(
-                max(self.limits.shutdown_budget_s, self._deadline - time.monotonic()), "drawing"
-            )
         if isinstance(reply, Yield):
             self._move(NodeState.SLEEPING)
             return reply
@@ -265,7 +269,7 @@ class NodeProcess:
             raise NodeUsageError(f"node {self.name} is {self.state}, not finishing")
         until = min(self._deadline, time.monotonic() + timeout_s)
         reply = self._receive_until(until)
-        while isinstance(reply, Drawing):  # it has the end budget already
+        while isinstance(reply, Drawing | LibraryLoading):  # it has the end budget already
             reply = self._receive_until(until)
         if isinstance(reply, Exited):
             self._finish(reply)
@@ -334,6 +338,30 @@ class NodeProcess:
         """Start the clock on a reply: it must come within `budget_s`."""
         self._budget_s, self._budget_what = budget_s, what
         self._deadline = time.monotonic() + budget_s
+        self._paused = None
+
+    def _drawing(self) -> None:
+        """Saving a figure may take seconds: this step gets the end budget instead."""
+        paused, left_s = self._paused, self._deadline - time.monotonic()
+        self._expect(max(self.limits.shutdown_budget_s, left_s), "drawing")
+        if paused is not None:  # drawing while a library loads: the end budget after it too
+            self._paused = (max(self.limits.shutdown_budget_s, paused[0]), *self._budget())
+
+    def _library_loading(self, done: bool) -> None:
+        """The step's clock stops while a library loads (protocol.LibraryLoading): the load
+        gets the end budget, and the step then has the time it had left before."""
+        if not done:
+            left_s = self._deadline - time.monotonic()
+            saved = (left_s, *self._budget())
+            self._expect(max(self.limits.shutdown_budget_s, left_s), "library loading")
+            self._paused = saved
+        elif self._paused is not None:
+            left_s, budget_s, what = self._paused
+            self._expect(budget_s, what)
+            self._deadline = time.monotonic() + left_s
+
+    def _budget(self) -> tuple[float, str]:
+        return self._budget_s, self._budget_what
 
     def _overdue(self) -> Exited:
         return self.kill(

@@ -207,6 +207,16 @@ class Drawing(msgspec.Struct, tag=True, frozen=True):
     is in gets the end budget instead of the step budget (sent at most once per wake)."""
 
 
+class LibraryLoading(msgspec.Struct, tag=True, frozen=True):
+    """A library the node's code has just used for the first time is loading (`done` False),
+    or has loaded (`done` True): matplotlib.pyplot, whose import runs at its first use in a
+    node started cold (sandbox/host.py). The step's clock stops in between, so the load is the
+    library's cost, not the controller's, and only the load: the rest of the step keeps its
+    budget (sent in pairs, from the node's main thread)."""
+
+    done: bool
+
+
 class Finishing(msgspec.Struct, tag=True, frozen=True):
     """The node has ended its part in the run (signal_shutdown(), its script returned or
     raised) and is finishing: shutdown hooks, figures, files. It will not sleep again; its
@@ -226,7 +236,7 @@ class Exited(msgspec.Struct, tag=True, frozen=True):
 
 
 ToChild = Load | Wake | Shutdown
-ToParent = Ready | Yield | Drawing | Finishing | Exited
+ToParent = Ready | Yield | Drawing | LibraryLoading | Finishing | Exited
 
 
 class ProtocolError(RuntimeError):

@@ -20,7 +20,7 @@ import contextlib
 import sys
 import threading
 import traceback
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -33,6 +33,7 @@ from sandbox.protocol import (
     Envelope,
     Finishing,
     GraphTopic,
+    LibraryLoading,
     NodeInfo,
     ProtocolError,
     Shutdown,
@@ -238,6 +239,26 @@ class NodeRuntime:
         with contextlib.suppress(ROSInterruptException):
             self.wait_until(self.clock.now_ns())
 
+    @contextlib.contextmanager
+    def library_loading(self) -> Iterator[None]:
+        """The student's code has just used a library whose import was deferred (sandbox/host.py)
+        and it loads now: the parent stops the step's clock meanwhile (protocol.LibraryLoading),
+        as the load is the library's cost, paid once, not the controller's."""
+        if threading.get_ident() != self._main_thread:
+            yield  # only the main thread's wake has a clock to stop
+            return
+        self._send_frame(LibraryLoading(done=False))
+        try:
+            yield
+        finally:
+            self._send_frame(LibraryLoading(done=True))
+
+    def _send_frame(self, frame: object) -> None:
+        try:
+            self.link.send(frame)
+        except ProtocolError as error:
+            raise LinkLost(error) from error
+
     def note_drawing(self) -> None:
         """The student's code is saving a figure (or, in a node started cold, importing a heavy
         library: sandbox/host.py): tell the parent once per wake, so the step gets the end
@@ -246,10 +267,7 @@ class NodeRuntime:
         if self._drawing_noted or threading.get_ident() != self._main_thread:
             return
         self._drawing_noted = True
-        try:
-            self.link.send(Drawing())
-        except ProtocolError as error:
-            raise LinkLost(error) from error
+        self._send_frame(Drawing())
 
     # ------------------------------------------------------------------ shutdown
     def on_shutdown(self, hook: Callable[[], Any]) -> None:
@@ -465,6 +483,11 @@ def current() -> NodeRuntime:
         raise ROSInitException(
             "rospy works inside a RoboDojo node only: run this file as a controller"
         )
+    return _current
+
+
+def active() -> NodeRuntime | None:
+    """The runtime of the node running in this process, None between nodes."""
     return _current
 
 

@@ -25,6 +25,7 @@ from sandbox.protocol import (
     Exited,
     Finishing,
     GraphTopic,
+    LibraryLoading,
     Load,
     NodeInfo,
     Outcome,
@@ -85,6 +86,7 @@ class Parent:
         self.crash: BaseException | None = None
         self.finishing: Finishing | None = None
         self.drawings = 0  # Drawing frames seen (a figure being saved)
+        self.library_loads: list[bool] = []  # LibraryLoading frames seen (their `done`)
         load = Load(textwrap.dedent(code), filename, api, info or crowbot_info("student"))
 
         def child() -> None:
@@ -109,6 +111,9 @@ class Parent:
             frame = self._decoder.decode(data)
             if isinstance(frame, Drawing):
                 self.drawings += 1
+                continue
+            if isinstance(frame, LibraryLoading):
+                self.library_loads.append(frame.done)
                 continue
             if isinstance(frame, Finishing):
                 assert self.finishing is None, "a node finishes once"

@@ -294,6 +294,81 @@ def test_a_cold_node_importing_heavy_libraries_mid_run_gets_the_end_budget():
         launcher.close()
 
 
+PYPLOT_FIRST_USED_IN_A_LATER_STEP = """
+import json
+import sys
+
+import skfuzzy.control  # imports matplotlib.pyplot for its visualizer
+import matplotlib.pyplot as plt
+
+ran_at_import = "matplotlib.figure" in sys.modules
+
+def step(obs):
+    if obs.time > 0.15 and not plt.get_fignums():
+        plt.plot([0.0, 1.0])
+        plt.savefig("late.png")
+        with open("pyplot.json", "w") as f:
+            json.dump({"ran_at_import": ran_at_import, "backend": plt.get_backend()}, f)
+    return (0.1, 0.0)
+"""
+
+
+def test_a_cold_node_runs_pyplot_only_when_it_is_used():
+    """`import skfuzzy.control` imports matplotlib.pyplot, whose code (~0.25 s) runs only when
+    the controller first uses it: a fuzzy controller that never draws does not pay for it. The
+    step that uses it first gets the end budget (50 ms step budget here), the backend is still
+    Agg and the figure comes back."""
+    limits = dataclasses.replace(TEST_LIMITS, step_budget_s=0.05, shutdown_budget_s=30.0)
+    launcher = Launcher(limits=limits, pool_size=0)
+    node = launcher.start("late")
+    try:
+        info = crowbot_info("late")
+        reply = node.load(PYPLOT_FIRST_USED_IN_A_LATER_STEP, "late.py", Api.STEP, info)
+        for k in range(1, 4):
+            assert isinstance(reply, Yield), reply
+            reply = node.wake(0.1 * k, [])
+        assert isinstance(reply, Yield), reply
+        exited = node.shutdown("finished: duration reached")
+    finally:
+        node.close()
+        launcher.close()
+    assert exited.outcome is Outcome.SHUTDOWN and exited.error is None, exited
+    artifacts = {a.name: a.data for a in exited.artifacts}
+    assert artifacts["late.png"].startswith(b"\x89PNG")
+    assert json.loads(artifacts["pyplot.json"]) == {"ran_at_import": False, "backend": "Agg"}
+
+
+PYPLOT_THEN_A_SPIN = """
+import time
+import matplotlib.pyplot as plt
+
+def step(obs):
+    if obs.time > 0.15:
+        plt.figure()  # pyplot loads here: the step's clock stops meanwhile
+        start = time.process_time()
+        while time.process_time() - start < 1.5:  # then the controller spins
+            pass
+    return (0.1, 0.0)
+"""
+
+
+def test_the_step_that_loads_pyplot_keeps_its_budget_for_the_rest():
+    """The clock stops for the load only: a step that first uses pyplot and then computes for
+    longer than its budget is still stopped."""
+    limits = dataclasses.replace(TEST_LIMITS, step_budget_s=0.2, shutdown_budget_s=30.0)
+    launcher = Launcher(limits=limits, pool_size=0)
+    node = launcher.start("spinner")
+    try:
+        reply = node.load(PYPLOT_THEN_A_SPIN, "spinner.py", Api.STEP, crowbot_info("spinner"))
+        for k in range(1, 4):
+            reply = node.wake(0.1 * k, []) if isinstance(reply, Yield) else reply
+    finally:
+        node.close()
+        launcher.close()
+    assert isinstance(reply, Exited) and reply.outcome is Outcome.KILLED, reply
+    assert "exceeded its 0.2 s step budget at t=0.200 s" in reply.reason
+
+
 def test_the_sandbox_package_is_compiled_before_nodes_read_it(tmp_path, monkeypatch):
     """Nodes see the package read-only and write no bytecode: the launcher writes it first."""
     from sandbox import bwrap
