@@ -210,19 +210,28 @@ def _note_heavy_imports(stack: ExitStack, node: NodeRuntime) -> None:
     stack.callback(hook.remove)
 
 
-def _defer_pyplot(stack: ExitStack) -> None:
-    """In a node started cold, `import matplotlib.pyplot` binds the module and runs its code at
-    its first use (sandbox/after_import.py): scikit-fuzzy imports pyplot for its visualizer
-    alone, ~0.25 s of CPU at every start of a fuzzy controller that never draws. The step that
-    first uses pyplot has its clock stopped while pyplot loads (NodeRuntime.library_loading),
-    so it keeps its budget for the rest, as the import in an earlier step left it."""
-    hook = DeferredImport("matplotlib.pyplot", _library_loading)
-    hook.install()
-    stack.callback(hook.remove)
+# Modules that libraries import for what controllers rarely use: in a node started cold,
+# `import` binds them and their code runs at their first use (sandbox/after_import.py). CPU
+# each saves at every start of a node that imports skfuzzy.control and never uses it (issue 18):
+DEFERRED_MODULES = (
+    "matplotlib.pyplot",  # ~0.25 s: scikit-fuzzy imports it for its visualizer alone
+    "numpy.f2py",  # ~0.1 s (charset_normalizer with it): scipy's `from numpy import *`
+    "numpy.testing",  # ~0.03 s: the same star import
+)
+
+
+def _defer_imports(stack: ExitStack) -> None:
+    """The step that first uses a deferred module has its clock stopped while the module loads
+    (NodeRuntime.library_loading), so it keeps its budget for the rest, as an import in an
+    earlier step would have left it."""
+    for name in DEFERRED_MODULES:
+        hook = DeferredImport(name, _library_loading)
+        hook.install()
+        stack.callback(hook.remove)
 
 
 def _library_loading() -> contextlib.AbstractContextManager[object]:
-    """Through the node running now, if any (pyplot may be used first by a later node of the
+    """Through the node running now, if any (a module may be used first by a later node of the
     same process, or after the node: the tests run many in one)."""
     node = runtime.active()
     return node.library_loading() if node is not None else contextlib.nullcontext()
@@ -255,7 +264,7 @@ def _environment(stack: ExitStack, node: NodeRuntime, load: Load, workdir: str) 
     _install_logging(stack, node)
     _note_figure_saving(stack, node)
     _note_heavy_imports(stack, node)
-    _defer_pyplot(stack)
+    _defer_imports(stack)
     lockstep = load.info.clock is Clock.LOCKSTEP
     stack.callback(TimePatch(node.clock, node.sleep_for, node.poll, clocks=lockstep).remove)
     runtime.activate(node)
