@@ -208,11 +208,11 @@ class Drawing(msgspec.Struct, tag=True, frozen=True):
 
 
 class LibraryLoading(msgspec.Struct, tag=True, frozen=True):
-    """A library the node's code has just used for the first time is loading (`done` False),
-    or has loaded (`done` True): matplotlib.pyplot, whose import runs at its first use in a
-    node started cold (sandbox/host.py). The step's clock stops in between, so the load is the
-    library's cost, not the controller's, and only the load: the rest of the step keeps its
-    budget (sent in pairs, from the node's main thread)."""
+    """A module the node's code has just used for the first time is loading (`done` False), or
+    has loaded (`done` True): one whose import runs at its first use in a node started cold,
+    such as matplotlib.pyplot (sandbox/host.py, DEFERRED_MODULES). The step's clock stops in
+    between, so the load is the library's cost, not the controller's, and only the load: the
+    rest of the step keeps its budget (sent in pairs, from the node's main thread)."""
 
     done: bool
 

@@ -118,6 +118,7 @@ class NodeRuntime:
     names: Names | None = None  # ROS name resolution for this node (sandbox.names)
     topics: TopicTable = field(init=False)
     _drawing_noted: bool = False
+    _libraries_loading: int = 0  # deferred modules loading now, one inside another's load
     _waiting: bool = False
     _main_thread: int = field(default_factory=threading.get_ident)
     busy: BusyLoopModel = field(init=False)
@@ -244,13 +245,15 @@ class NodeRuntime:
         """The student's code has just used a library whose import was deferred (sandbox/host.py)
         and it loads now: the parent stops the step's clock meanwhile (protocol.LibraryLoading),
         as the load is the library's cost, paid once, not the controller's."""
-        if threading.get_ident() != self._main_thread:
-            yield  # only the main thread's wake has a clock to stop
+        if threading.get_ident() != self._main_thread or self._libraries_loading:
+            yield  # only the main thread's wake has a clock, stopped once for nested loads
             return
+        self._libraries_loading += 1
         self._send_frame(LibraryLoading(done=False))
         try:
             yield
         finally:
+            self._libraries_loading -= 1
             self._send_frame(LibraryLoading(done=True))
 
     def _send_frame(self, frame: object) -> None:

@@ -8,13 +8,16 @@ fails here too.
 from __future__ import annotations
 
 import queue
+import sys
 import textwrap
 import threading
 from collections.abc import Callable, Iterable
 from pathlib import Path
 
 import msgspec
+import pytest
 
+from sandbox import host
 from sandbox.host import run_node
 from sandbox.limits import DEFAULT_LIMITS, Limits
 from sandbox.msgs import Message
@@ -209,3 +212,43 @@ def test_a_broken_pipe_reaches_the_runner_as_protocol_error(tmp_path: Path) -> N
         assert "closed" in str(error)
     else:
         raise AssertionError("run_node should have raised ProtocolError")
+
+
+def test_a_deferred_module_loads_between_one_pair_of_library_loading_frames(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A module of host.DEFERRED_MODULES runs at its first use, between LibraryLoading(done=
+    False) and (done=True), so the parent stops the step's clock for the load; another deferred
+    module its code uses loads inside the same pair."""
+    package = tmp_path / "lib" / "deferpkg2"
+    package.mkdir(parents=True)
+    (package / "__init__.py").write_text("")
+    (package / "inner.py").write_text("VALUE = 41\n")
+    (package / "outer.py").write_text("import deferpkg2.inner as inner\nVALUE = inner.VALUE + 1\n")
+    monkeypatch.syspath_prepend(str(tmp_path / "lib"))
+    monkeypatch.setattr(host, "DEFERRED_MODULES", ("deferpkg2.outer", "deferpkg2.inner"))
+    workdir = tmp_path / "work"
+    workdir.mkdir()
+    try:
+        parent = Parent(
+            """
+            import sys
+            import rospy
+            import deferpkg2.outer as outer
+            rospy.init_node("user")
+            ran_at_import = "deferpkg2.inner" in sys.modules
+            rospy.sleep(0.1)
+            with open("seen.txt", "w") as f:
+                f.write(f"{ran_at_import} {outer.VALUE}")
+            """,
+            workdir,
+        )
+        first = parent.next()
+        assert isinstance(first, Yield) and parent.library_loads == []  # bound, not run
+        exited = parent.wake(0.1)
+        assert isinstance(exited, Exited) and exited.outcome is Outcome.FINISHED, exited
+        assert parent.library_loads == [False, True]
+        assert (workdir / "seen.txt").read_text() == "False 42"
+    finally:
+        for name in ("deferpkg2.outer", "deferpkg2.inner", "deferpkg2"):
+            sys.modules.pop(name, None)
