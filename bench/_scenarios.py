@@ -276,7 +276,11 @@ async def memory_pass(lab: Lab, webs: list[Web], args: argparse.Namespace) -> di
         processes |= {f"worker {i + 1}": p for i, p in enumerate(lab.worker_processes())}
         samples: dict[str, list[tuple[float, float]]] = {name: [] for name in processes}
         if args.tracemalloc:
-            print("  heap snapshots after the warm-up ...", flush=True)
+            # Both snapshots must see runs in every stage: on a slow (traced, loaded) lab the
+            # first round may still be starting after its nominal length.
+            while len(done) < len(students) and time.monotonic() < until:
+                await asyncio.sleep(1.0)
+            print(f"  heap snapshots after the warm-up ({len(done)} runs ended) ...", flush=True)
             early = await _heap.snapshot_all(processes, args.heap_dir)
         window.start = time.monotonic()
         while time.monotonic() < until:
