@@ -32,7 +32,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 LOGIN_LINE = re.compile(r"log in as the instructor at \S+/login\?token=(\S+)")
-START_TIMEOUT_S = 60.0  # [s] a cold web process with a sandbox pool on a loaded 2-core machine
+START_TIMEOUT_S = 180.0  # [s] a cold web process on a loaded 2-core machine, traced (--tracemalloc)
 STOP_TIMEOUT_S = 30.0  # [s] SIGTERM, then SIGKILL: a lab process stops its runs first
 HTTP_TIMEOUT_S = 10.0  # [s] a status answer slower than this counts as an error
 MAX_HTTP_IN_FLIGHT = 64  # open-loop requests pending at once; more are counted as skipped

@@ -13,6 +13,7 @@ import statistics
 import time
 from array import array
 
+import _heap
 import psutil
 from _class import (
     StudentRun,
@@ -251,7 +252,9 @@ def _median(values: list[float]) -> float:
 
 # ------------------------------------------------------------------------------ c: memory
 async def memory_pass(lab: Lab, webs: list[Web], args: argparse.Namespace) -> dict:
-    """Runs replacing each other for --minutes; every web and worker process's RSS sampled."""
+    """Runs replacing each other for --minutes; every web and worker process's RSS sampled.
+    With --tracemalloc (a lab started with _heap.environment), each process also writes a heap
+    snapshot after the warm-up and at the window's end; "heap" holds their comparison."""
     students = await make_students(webs, lab.admin_token, args.churn_runs, "c")
     rate_hz = args.b_rate
     done: list[StudentRun] = []
@@ -272,6 +275,13 @@ async def memory_pass(lab: Lab, webs: list[Web], args: argparse.Namespace) -> di
         await asyncio.sleep(args.churn_run_s)
         processes |= {f"worker {i + 1}": p for i, p in enumerate(lab.worker_processes())}
         samples: dict[str, list[tuple[float, float]]] = {name: [] for name in processes}
+        if args.tracemalloc:
+            # Both snapshots must see runs in every stage: on a slow (traced, loaded) lab the
+            # first round may still be starting after its nominal length.
+            while len(done) < len(students) and time.monotonic() < until:
+                await asyncio.sleep(1.0)
+            print(f"  heap snapshots after the warm-up ({len(done)} runs ended) ...", flush=True)
+            early = await _heap.snapshot_all(processes, args.heap_dir)
         window.start = time.monotonic()
         while time.monotonic() < until:
             for name, process in processes.items():
@@ -281,7 +291,12 @@ async def memory_pass(lab: Lab, webs: list[Web], args: argparse.Namespace) -> di
                     continue  # a worker that ended: its line shows fewer samples
                 samples[name].append(((time.monotonic() - window.start) / 60, rss))
             await asyncio.sleep(MEMORY_SAMPLE_S)
+            if args.tracemalloc and time.monotonic() > until - args.churn_run_s:
+                break  # the late snapshots while runs still replace each other
         window.end = time.monotonic()
+        if args.tracemalloc:
+            print("  heap snapshots at the end ...", flush=True)
+            late = await _heap.snapshot_all(processes, args.heap_dir)
         await asyncio.wait(loops, timeout=args.churn_run_s + END_TIMEOUT_S)
     finally:
         for task in loops:
@@ -298,7 +313,18 @@ async def memory_pass(lab: Lab, webs: list[Web], args: argparse.Namespace) -> di
             "end_mib": rss[-1] if rss else math.nan,
             "samples": len(points),
         }
-    return {"runs_done": len(done), "lost": lost(done, stopped_by_us=False), "processes": slopes}
+    heap = {}
+    if args.tracemalloc:
+        minutes = (window.end - window.start) / 60
+        for name in sorted(set(early) & set(late)):
+            heap[name] = await asyncio.to_thread(_heap.compare, early[name], late[name], minutes)
+            heap[name]["rss_mib"] = (slopes[name]["start_mib"], slopes[name]["end_mib"])
+    return {
+        "runs_done": len(done),
+        "lost": lost(done, stopped_by_us=False),
+        "processes": slopes,
+        "heap": heap,
+    }
 
 
 def report_memory(name: str, figures: dict, minutes: float) -> None:
@@ -314,3 +340,7 @@ def report_memory(name: str, figures: dict, minutes: float) -> None:
             f"{f['slope_mib_per_min']:+.3f} MiB/min (second half {f['second_half_slope']:+.3f}; "
             f"{f['samples']} samples) -> {verdict}"
         )
+    if figures.get("heap"):
+        print("  where the Python heap grew (tracemalloc; the traced processes run slower):")
+        for process, heap in figures["heap"].items():
+            _heap.report(process, heap, heap["rss_mib"])

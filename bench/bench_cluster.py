@@ -13,7 +13,9 @@ b  --b-runs (100) realtime runs at --b-rate (10 Hz), one live viewer each (Dista
    on the live socket (sent -> ack read), GET /api/runs/{id} at --http-rate (sent -> answer),
    runs lost (every run must end as asked: interrupted by our stop);
 c  --churn-runs (20) students whose runs (--churn-run-s long, a viewer each) replace each other
-   for --minutes (10): resident memory of every web and worker process, least-squares slope.
+   for --minutes (10): resident memory of every web and worker process, least-squares slope;
+   with --tracemalloc, also where each process's Python heap grew between a snapshot after the
+   warm-up and one at the end, by allocation site (bench/_heap.py; tracing slows the lab).
 
 The period p99 of a run is read twice: "steady", over its newest 1,000 wakes while it runs
 (GET /api/runs/{id} nodes_live; the warm-up is stretched so that these all fall after every
@@ -30,6 +32,7 @@ the figures (e.g. "loaded" while the machine is shared).
 
 Usage: python bench/bench_cluster.py --mode cluster [--scenarios a,b,c] [--repeats 2]
        [--minutes 10] [--measure 60] [--sweep 10,20,50,100] [--label loaded] [--json out.jsonl]
+       python bench/bench_cluster.py --scenarios c --repeats 1 --tracemalloc   # where MiB go
 Targets (issue 16): a) p99 < 11 ms; b) period p99 < 110 ms, delivery, commands and HTTP p99
 < 50 ms, 0 runs lost; c) < 0.5 MiB/min for each web and worker process.
 """
@@ -46,6 +49,7 @@ import sys
 import tempfile
 from pathlib import Path
 
+import _heap
 import httpx
 from _class import Web
 from _common import HTTP_TIMEOUT_S, MAX_HTTP_IN_FLIGHT, BenchError, stop_on_sigterm
@@ -237,12 +241,19 @@ def main() -> None:
     )
     parser.add_argument("--sweep-start", type=int, default=8)
     parser.add_argument("--sweep-steps", type=int, default=2, help="halvings after a failure")
+    parser.add_argument(
+        "--tracemalloc",
+        action="store_true",
+        help="c: where the heap of each web and worker process grew (bench/_heap.py)",
+    )
     parser.add_argument("--label", default="quiet", help="how loaded the machine was")
     parser.add_argument("--json", type=Path, default=None, help="append figures to this file")
     args = parser.parse_args()
     args.scenarios = [s for s in args.scenarios.split(",") if s]
     if set(args.scenarios) - {"a", "b", "c"}:
         parser.error("--scenarios takes a, b and c")
+    if args.tracemalloc and "c" not in args.scenarios:
+        parser.error("--tracemalloc watches scenario c: add c to --scenarios")
     if args.mode == "cluster" and args.workers is not None:
         parser.error("--workers is for --mode single; the cluster runs two `robodojo worker`s")
     workers = "default" if args.workers is None else args.workers
@@ -251,9 +262,14 @@ def main() -> None:
     passes = []
     for number in range(1, args.repeats + 1):
         with tempfile.TemporaryDirectory(prefix="robodojo-bench-cluster-") as data:
+            env = ENV
+            if args.tracemalloc:  # kept after the pass, to look further with tracemalloc
+                args.heap_dir = Path(tempfile.mkdtemp(prefix="robodojo-heap-"))
+                print(f"heap snapshots of pass {number} go to {args.heap_dir}", flush=True)
+                env = ENV | _heap.environment(args.heap_dir)
             try:
                 with open_lab(
-                    args.mode, Path(data), ENV, args.workers, args.worker_args.split()
+                    args.mode, Path(data), env, args.workers, args.worker_args.split()
                 ) as lab:
                     print(f"pass {number}: {lab.describe()}", flush=True)
                     results = asyncio.run(one_pass(lab, args, number))

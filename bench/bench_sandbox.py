@@ -32,6 +32,7 @@ import time
 
 from sandbox.launcher import Launcher
 from sandbox.protocol import Api, Clock, Envelope, NodeInfo, RobotTopic, Yield
+from server.sim.registry import topic_types
 
 INFO = NodeInfo(
     node_name="bench",
@@ -120,7 +121,7 @@ def bench_starts(count: int) -> None:
         stats(f"cold start, {label} (start -> first Yield)", times, 1e3, "ms")
     cold.close()
 
-    warm = Launcher(pool_size=2)
+    warm = Launcher(pool_size=2, message_types=topic_types())  # as the server starts it
     times = []
     for _ in range(count):
         while len(warm._pool) < 1:  # let the pool refill: we measure the warm path

@@ -85,10 +85,12 @@ class NodeProcess:
         font_cache: str | None = None,
         cgroups: Cgroups | CgroupsV2 | None = None,
         preload: bool = True,
+        message_types: tuple[str, ...] = (),
     ) -> None:
         """`preload`: import the heavy libraries (numpy, matplotlib, scipy, scikit-fuzzy,
         rclpy) before Ready, for a process that waits in the warm pool; without it the node is
-        Ready in a fraction of the time and the student's imports load what it uses."""
+        Ready in a fraction of the time and the student's imports load what it uses.
+        `message_types`: ROS 1 type names whose classes (and ROS 2 twins) it builds before Ready."""
         self.limits = limits
         self.sandboxed = sandboxed
         self.name = "(pool)"
@@ -105,6 +107,7 @@ class NodeProcess:
             "rlimits": _rlimits(limits),
             "seal": sandboxed,
             "preload": preload,
+            "message_types": list(message_types),
             "fd_in": to_child_r,
             "fd_out": from_child_w,
         }

@@ -44,6 +44,7 @@ from server.api.sockets import OpenSockets
 from server.editor.service import EditorService
 from server.service import disk
 from server.service.runs import RunService
+from server.sim.registry import topic_types
 from server.store import accounts
 from server.store import runs as run_store
 from server.store.accounts import Role
@@ -90,7 +91,9 @@ def create_app(settings: Settings | None = None, launcher: Launcher | None = Non
                             interrupted)  # fmt: skip
         own_launcher = launcher is None
         run_launcher = launcher or Launcher(
-            pool_size=settings.sandbox_pool, unsafe_no_sandbox=settings.unsafe_no_sandbox
+            pool_size=settings.sandbox_pool,
+            unsafe_no_sandbox=settings.unsafe_no_sandbox,
+            message_types=topic_types(),
         )
         app.state.settings = settings
         app.state.store = store

@@ -39,6 +39,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
     from sandbox.launcher import Launcher
     from server.api.app import create_app
     from server.api.http_server import h11_with_header_timeout, install_redaction
+    from server.sim.registry import topic_types
     from server.store.db import Store
     from server.workers.choose import local_worker_count
 
@@ -54,6 +55,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
     launcher = Launcher(
         pool_size=settings.sandbox_pool if runs_here else 0,
         unsafe_no_sandbox=settings.unsafe_no_sandbox,
+        message_types=topic_types(),
     )
     try:
         config = uvicorn.Config(

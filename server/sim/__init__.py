@@ -8,7 +8,7 @@ that says what it is.
 
 from server.sim.backend import RobotBackend, WorldView
 from server.sim.checks import DefinitionError, check_robot, check_world
-from server.sim.registry import get_robot, robot_ids, robots_for_world
+from server.sim.registry import get_robot, robot_ids, robots_for_world, topic_types
 from server.sim.robots.base import Direction, TopicSpec
 from server.sim.simulation import EventKind, Published, Scene, SimEvent, Simulation, SimulationError
 from server.sim.state import Pose2D, RobotState
@@ -34,5 +34,6 @@ __all__ = [
     "load_world",
     "robot_ids",
     "robots_for_world",
+    "topic_types",
     "world_ids",
 ]

@@ -59,12 +59,27 @@ def _lag(current: float, target: float, dt_s: float, time_constant_s: float) -> 
     return target + (current - target) * _lag_factor(dt_s, time_constant_s)
 
 
-@functools.lru_cache(maxsize=256)
+# One table of powers per lag factor (a robot's motors share one), as long as the longest tick
+# run asked for so far (doubling): a run of n ticks reads the table's first n. An lru_cache keyed
+# by (factor, ticks) held an array per distinct tick count instead, and a realtime run asks for
+# whatever count the wall clock gives: up to 256 arrays of up to ~200 KB each (1.3 MiB in one
+# worker process after 10 minutes of runs, `bench_cluster.py --tracemalloc`), bounded in number
+# only. factor**k is computed element by element, so a prefix of a longer table is the same.
+_POWER_TABLES: dict[float, np.ndarray] = {}
+MAX_POWER_TABLES = 64  # distinct lag factors kept (one per motor model and physics tick)
+
+
 def _lag_powers(factor: float, ticks: int) -> np.ndarray:
     """factor**1 .. factor**ticks, read-only: the part of the old error left after each tick."""
-    powers = factor ** np.arange(1, ticks + 1, dtype=np.float64)
-    powers.flags.writeable = False
-    return powers
+    table = _POWER_TABLES.get(factor)
+    if table is None or len(table) < ticks:
+        length = max(ticks, 2 * len(table)) if table is not None else ticks
+        table = factor ** np.arange(1, length + 1, dtype=np.float64)
+        table.flags.writeable = False
+        if len(_POWER_TABLES) >= MAX_POWER_TABLES:
+            _POWER_TABLES.clear()
+        _POWER_TABLES[factor] = table  # threads racing here each keep a correct table
+    return table[:ticks]
 
 
 def _lag_many(current: float, target: float, ticks: int, factor: float) -> np.ndarray:

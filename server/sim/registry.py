@@ -35,6 +35,13 @@ def get_robot(robot_id: str) -> RobotModel:
     return cls()
 
 
+def topic_types() -> tuple[str, ...]:
+    """The ROS 1 type names of every robot's topics (the warm sandboxes build their classes)."""
+    return tuple(
+        sorted({topic.type_name for robot_id in _ROBOTS for topic in get_robot(robot_id).topics()})
+    )
+
+
 def robots_for_world(robot_id: str) -> tuple[str, ...]:
     """Ids of the worlds that declare they suit `robot_id`."""
     return tuple(w for w in world_ids() if robot_id in load_world(w).robots)

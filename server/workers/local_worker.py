@@ -23,6 +23,7 @@ from multiprocessing.connection import Connection
 
 from sandbox.launcher import Launcher
 from server.runs.commands import CommandError
+from server.sim.registry import topic_types
 from server.store.db import Store
 from server.workers.host import RunHost
 from server.workers.wire import (
@@ -65,7 +66,9 @@ class LocalWorker:
         self._closing = threading.Event()
         self.store = Store.open(settings.store_url)
         self.launcher = Launcher(
-            pool_size=settings.sandbox_pool, unsafe_no_sandbox=settings.unsafe_no_sandbox
+            pool_size=settings.sandbox_pool,
+            unsafe_no_sandbox=settings.unsafe_no_sandbox,
+            message_types=topic_types(),
         )
         self.host = RunHost(self.store, settings, self.launcher, PipeOutlet(self.send), worker_id)
 

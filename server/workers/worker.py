@@ -24,6 +24,7 @@ from sandbox.launcher import Launcher
 from server.runs.commands import CommandError
 from server.runs.state import RunState
 from server.service.hardware import HardwareHub
+from server.sim.registry import topic_types
 from server.store import robots as inventory
 from server.store import workers as roster
 from server.store.db import Store
@@ -63,7 +64,9 @@ class WorkerProcess:
         self.broker = queue.make_broker(settings.redis_url)
         self.own_launcher = launcher is None
         self.launcher = launcher or Launcher(
-            pool_size=settings.sandbox_pool, unsafe_no_sandbox=settings.unsafe_no_sandbox
+            pool_size=settings.sandbox_pool,
+            unsafe_no_sandbox=settings.unsafe_no_sandbox,
+            message_types=topic_types(),
         )
         self.outlet = RedisOutlet(self.client)
         # A bench worker (`--rosserial-port`) holds the robots' connections and runs their runs.

@@ -13,7 +13,7 @@ import pytest
 from sandbox.bwrap import SandboxUnavailable
 from sandbox.launcher import DANGER, Launcher, NodeUsageError
 from sandbox.protocol import Api, Envelope, Exited, Finishing, Outcome, Yield
-from tests.sandbox.conftest import TEST_LIMITS, crowbot_info, run_script
+from tests.sandbox.conftest import TEST_LIMITS, WarmOnlyLauncher, crowbot_info, run_script
 
 COURSE_SCRIPT = """
 import time
@@ -385,3 +385,36 @@ def test_the_sandbox_package_is_compiled_before_nodes_read_it(tmp_path, monkeypa
     assert bwrap.precompile_package()
     assert list((package / "__pycache__").glob("host.*.pyc"))
     assert list((package / "msgs" / "__pycache__").glob("core.*.pyc"))
+
+
+def test_an_unknown_message_type_to_build_ahead_fails_at_once_with_a_sentence():
+    """A name the warm nodes could not build is the server's mistake: said when the launcher is
+    made, not by every pool process failing to start."""
+    with pytest.raises(KeyError, match="sensor_msgs/LaserScn"):
+        Launcher(limits=TEST_LIMITS, pool_size=0, message_types=["sensor_msgs/LaserScn"])
+
+
+WARM_STATE = """
+import json
+import sys
+from sandbox.msgs import _core
+
+with open("state.json", "w") as f:
+    json.dump({"built": "sensor_msgs/LaserScan" in _core._REGISTRY,
+               "rclpy": "rclpy" in sys.modules}, f)
+"""
+
+
+@pytest.mark.slow
+def test_a_warm_node_starts_with_its_message_classes_built_and_no_ros2_module():
+    launcher = WarmOnlyLauncher(
+        limits=TEST_LIMITS, pool_size=1, message_types=["sensor_msgs/LaserScan"]
+    )
+    try:
+        reply, node = run_script(launcher, WARM_STATE, "state")
+        node.close()
+    finally:
+        launcher.close()
+    assert isinstance(reply, Exited) and reply.outcome is Outcome.FINISHED, reply
+    artifacts = {a.name: a.data for a in reply.artifacts}
+    assert json.loads(artifacts["state.json"]) == {"built": True, "rclpy": False}

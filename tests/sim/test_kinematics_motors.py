@@ -99,3 +99,27 @@ def test_velocity_motors_clamp_each_wheel_and_limit_acceleration():
         left, right = motors.step(0.1)
     assert left * 0.036 == pytest.approx(0.5)  # per-wheel clamp at 0.5 m/s
     assert right == left  # per-wheel clamp at 0.5 m/s
+
+
+def test_lag_powers_keep_one_table_per_factor_whatever_tick_counts_runs_ask_for():
+    """A realtime run steps whatever tick count the wall clock gives; the powers it reads stay
+    one table per lag factor (a cache per count held 256 arrays: MiB in a worker process)."""
+    import tracemalloc
+
+    import numpy as np
+
+    from server.sim import motors
+
+    factor = 0.998_765  # a factor no other test uses: its table starts empty
+    tracemalloc.start()
+    try:
+        before = tracemalloc.get_traced_memory()[0]
+        for ticks in range(1000, 1300):
+            powers = motors._lag_powers(factor, ticks)
+            assert len(powers) == ticks and not powers.flags.writeable
+        held = tracemalloc.get_traced_memory()[0] - before
+    finally:
+        tracemalloc.stop()
+    assert held < 64 * 1024, f"{held / 1024:.0f} KiB held for 300 tick counts"
+    expected = factor ** np.arange(1, 1300, dtype=np.float64)
+    assert np.array_equal(motors._lag_powers(factor, 1299), expected)  # bit for bit
