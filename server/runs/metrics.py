@@ -36,22 +36,44 @@ class Samples:
 
 def _summary(values: array) -> dict:
     """`values` is a copy: a numpy view of the live array would stop the run thread from
-    appending (an array exporting its buffer cannot grow)."""
+    appending (an array exporting its buffer cannot grow).
+
+    The figures are numpy's (`percentile`'s linear method, `histogram`'s bins), computed from
+    one sort: np.percentile and np.histogram took ~360 us on 1,000 values, and a worker reads
+    a summary of every live run once a second (issue 16)."""
     data = np.frombuffer(values, dtype=np.float64)
     if not len(data):
         return {"count": 0}
-    p50, p95, p99 = np.percentile(data, [50, 95, 99])
-    top = max(float(data.max()), 1e-9)
-    counts, edges = np.histogram(data, bins=HISTOGRAM_BINS, range=(0.0, top))
+    ordered = np.sort(data)
+    p50, p95, p99 = (_percentile(ordered, q) for q in (0.50, 0.95, 0.99))
+    top = max(float(ordered[-1]), 1e-9)
+    edges = np.linspace(0.0, top, HISTOGRAM_BINS + 1)
+    # Bin i holds edges[i] <= x < edges[i + 1], the last one its right edge too (np.histogram).
+    bounds = np.searchsorted(ordered, edges, side="left")
+    bounds[-1] = np.searchsorted(ordered, edges[-1], side="right")
     return {
         "count": len(data),
-        "mean_s": float(data.mean()),
-        "p50_s": float(p50),
-        "p95_s": float(p95),
-        "p99_s": float(p99),
-        "max_s": float(data.max()),
-        "histogram": {"edges_s": edges.tolist(), "counts": counts.tolist()},
+        "mean_s": float(data.mean()),  # over the values in their order, as numpy sums them
+        "p50_s": p50,
+        "p95_s": p95,
+        "p99_s": p99,
+        "max_s": float(ordered[-1]),
+        "histogram": {"edges_s": edges.tolist(), "counts": np.diff(bounds).tolist()},
     }
+
+
+def _percentile(ordered: np.ndarray, quantile: float) -> float:
+    """np.percentile(..., method="linear") of sorted values, to the last bit: the same
+    interpolation, written as numpy's _lerp writes it (from the nearer neighbour)."""
+    index = quantile * (len(ordered) - 1)
+    below = int(index)
+    above = min(below + 1, len(ordered) - 1)
+    fraction = index - below
+    low, high = float(ordered[below]), float(ordered[above])
+    step = high - low
+    if fraction >= 0.5:
+        return high - step * (1.0 - fraction)
+    return low + step * fraction
 
 
 class NodeMetrics:

@@ -56,3 +56,27 @@ def test_a_node_that_comes_is_in_the_next_status_at_once(monkeypatch) -> None:
     slots["follower"] = SimpleNamespace(metrics=NodeMetrics())
     periods, _ = RunHost._figures(hosted, slots)
     assert set(periods) == {"controller", "follower"}
+
+
+def test_a_summary_is_numpys_percentiles_and_histogram_to_the_last_bit() -> None:
+    """The summary sorts once instead of calling np.percentile and np.histogram; its figures
+    must be theirs exactly (ties, one value, all zeros, values on bin edges included)."""
+    import random
+    from array import array
+
+    import numpy as np
+
+    from server.runs.metrics import HISTOGRAM_BINS, _summary
+
+    rng = random.Random(4)
+    cases = [[0.1], [0.0] * 7, [0.1] * 1000, [0.05, 0.1, 0.1, 0.15] * 25]
+    cases += [[abs(rng.gauss(0.1, 0.02)) for _ in range(rng.randint(2, 1200))] for _ in range(60)]
+    cases += [[rng.choice([0.0, 0.05, 0.1]) for _ in range(rng.randint(2, 300))] for _ in range(20)]
+    for values in cases:
+        data = np.array(values)
+        summary = _summary(array("d", values))
+        p50, p95, p99 = np.percentile(data, [50, 95, 99])
+        counts, edges = np.histogram(data, bins=HISTOGRAM_BINS, range=(0.0, max(data.max(), 1e-9)))
+        assert (summary["p50_s"], summary["p95_s"], summary["p99_s"]) == (p50, p95, p99)
+        assert summary["histogram"] == {"edges_s": edges.tolist(), "counts": counts.tolist()}
+        assert summary["max_s"] == data.max() and summary["mean_s"] == data.mean()
