@@ -18,7 +18,6 @@ from __future__ import annotations
 import contextlib
 import logging
 import threading
-import time
 from collections.abc import Callable
 
 import redis
@@ -52,8 +51,11 @@ class ChannelListener:
         self.connected = False
         self._wanted: set[str] = set()
         self._confirmed: set[str] = set()
+        # Waiters of `add`, told when Redis confirms their channel: a flag of their own, since
+        # `_confirmed` can lose the channel again before a waiter looks (a catch-up that finds
+        # the run over removes it at once).
+        self._waiters: dict[str, list[threading.Event]] = {}
         self._lock = threading.Lock()
-        self._changed = threading.Condition(self._lock)
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._loop, name=f"redis-{name}", daemon=True)
 
@@ -66,17 +68,21 @@ class ChannelListener:
 
     def add(self, channel: str, wait_s: float = 0.0) -> bool:
         """Listen to `channel`; with `wait_s`, wait that long for Redis to confirm (True)."""
+        confirmed = threading.Event()
         with self._lock:
             self._wanted.add(channel)
-            if wait_s <= 0:
+            if channel in self._confirmed or wait_s <= 0:
                 return channel in self._confirmed
-            deadline = time.monotonic() + wait_s
-            while channel not in self._confirmed:
-                left = deadline - time.monotonic()
-                if left <= 0 or self._stop.is_set():
-                    return False
-                self._changed.wait(left)
-            return True
+            self._waiters.setdefault(channel, []).append(confirmed)
+        try:
+            return confirmed.wait(wait_s)
+        finally:
+            with self._lock:
+                waiters = self._waiters.get(channel, [])
+                if confirmed in waiters:
+                    waiters.remove(confirmed)
+                if not waiters:
+                    self._waiters.pop(channel, None)
 
     def remove(self, channel: str) -> None:
         with self._lock:
@@ -99,7 +105,6 @@ class ChannelListener:
                 self.connected = False
                 with self._lock:
                     self._confirmed.clear()
-                    self._changed.notify_all()
                 self._stop.wait(delay)
                 delay = min(delay * 2, RECONNECT_MAX_S)
             else:
@@ -136,8 +141,10 @@ class ChannelListener:
         if kind == "subscribe":
             self._call(self.on_subscribed, channel)  # first: a waiter finds its work done
             with self._lock:
-                self._confirmed.add(channel)
-                self._changed.notify_all()
+                if channel in self._wanted:  # not removed meanwhile (by the callback, say)
+                    self._confirmed.add(channel)
+                for waiter in self._waiters.pop(channel, []):
+                    waiter.set()
         elif kind == "message":
             self._call(self.handle, channel, message.get("data"))
 

@@ -13,6 +13,7 @@ import redis
 
 from server.runs.commands import Button, Pause, Stop
 from server.workers.queue import redis_client
+from server.workers.redis_channels import ChannelListener
 from server.workers.redis_live import (
     CommandListener,
     LiveSubscriber,
@@ -156,6 +157,24 @@ def test_a_reaped_run_ends_for_its_viewers_even_after_its_worker_vanished(client
         assert late.batches[-1].final and late.events()[-1]["state"] == "failed"
     finally:
         other.stop()
+
+
+def test_a_subscription_dropped_by_its_own_catch_up_still_counts_as_confirmed(client):
+    # A late viewer's catch-up finds the run over and stops listening at once, on the listener's
+    # thread, before the viewer's `add` has looked: the viewer must still hear True, every time
+    # (it used to race the unsubscription and time out now and then).
+    def drop(channel: str) -> None:
+        listener.remove(channel)
+
+    listener = ChannelListener(client, handle=lambda channel, data: None, name="test",
+                               on_subscribed=drop)  # fmt: skip
+    listener.start()
+    try:
+        answers = [listener.add(f"robodojo:test:{n}", wait_s=10.0) for n in range(40)]
+        assert answers == [True] * 40
+        assert listener.wanted() == set()
+    finally:
+        listener.stop()
 
 
 @pytest.fixture
