@@ -9,6 +9,7 @@ from __future__ import annotations
 import logging
 import socket
 import threading
+from collections.abc import Sequence
 from concurrent.futures import ThreadPoolExecutor
 
 from sandbox.launcher import Launcher
@@ -34,8 +35,9 @@ class MirrorOutlet:
     def __init__(self, mirrors: Mirrors) -> None:
         self.mirrors = mirrors
 
-    def publish(self, batch: LiveBatch) -> None:
-        self.mirrors.apply(batch)
+    def publish_round(self, batches: Sequence[LiveBatch]) -> None:
+        for batch in batches:
+            self.mirrors.apply(batch)
 
 
 class InProcessExecutor:

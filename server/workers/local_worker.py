@@ -5,7 +5,7 @@ messages (server/workers/wire.py codecs; never pickle):
 
     parent -> child   {"op": "job", "job": ...}        {"op": "command", "request": ...}
                       {"op": "close", "grace_s": s}
-    child -> parent   {"op": "ready", "worker": id}    {"op": "batch", "batch": ...}
+    child -> parent   {"op": "ready", "worker": id}    {"op": "batches", "batches": [...]}
                       {"op": "answer", "answer": ...}  {"op": "warm", "count": n}
                       {"op": "closed"}
 
@@ -19,6 +19,7 @@ import logging
 import os
 import signal
 import threading
+from collections.abc import Sequence
 from multiprocessing.connection import Connection
 
 from sandbox.launcher import Launcher
@@ -49,11 +50,28 @@ class PipeOutlet:
     def __init__(self, send) -> None:
         self._send = send
 
-    def publish(self, batch: LiveBatch) -> None:
+    def publish_round(self, batches: Sequence[LiveBatch]) -> None:
+        """The round in one pipe message (one write, one wake of the web's reader). A batch
+        JSON refuses (a NaN) is left out with a line in the log; the others still go."""
+        encoded = [batch_to_json(batch) for batch in batches]
         try:
-            self._send({"op": "batch", "batch": batch_to_json(batch)})
-        except (OSError, ValueError):  # the web process is gone; this worker is ending too
-            log.warning("run %s: live batch lost, the web process is gone", batch.run_id)
+            try:
+                self._send({"op": "batches", "batches": encoded})
+            except ValueError:  # rare: find the bad batch and send the rest
+                encoded = [data for data in encoded if _encodable(data)]
+                if encoded:
+                    self._send({"op": "batches", "batches": encoded})
+        except OSError:  # the web process is gone; this worker is ending too
+            log.warning("a round of %d live batches lost: the web process is gone", len(batches))
+
+
+def _encodable(data: dict) -> bool:
+    try:
+        dumps(data)
+    except ValueError as error:
+        log.error("run %s: a live batch is not JSON and was dropped: %s", data["run_id"], error)
+        return False
+    return True
 
 
 class LocalWorker:

@@ -41,6 +41,7 @@ from server.workers.seams import ExecutorUnavailableError
 from server.workers.wire import (
     CommandAnswer,
     CommandRequest,
+    LiveBatch,
     RunJob,
     RunStatus,
     WireError,
@@ -188,14 +189,14 @@ class LocalProcessExecutor:
 
     def _on_message(self, child: _Child, message: dict) -> None:
         op = message.get("op")
-        if op == "batch":
-            batch = batch_from_json(message["batch"])
-            self.mirrors.apply(batch)
-            if batch.final:
-                with self._lock:
-                    child.runs.discard(batch.run_id)
-                    if self._where.get(batch.run_id) is child:
-                        del self._where[batch.run_id]
+        if op == "batches":  # one publisher round of the child's runs
+            for data in message["batches"]:
+                try:
+                    batch = batch_from_json(data)
+                except WireError as error:  # one bad batch; the round's others still count
+                    log.error("worker process %d sent a bad live batch: %s", child.index, error)
+                    continue
+                self._on_batch(child, batch)
         elif op == "answer":
             answer = answer_from_json(message["answer"])
             with self._lock:
@@ -210,6 +211,14 @@ class LocalProcessExecutor:
             child.warm = int(message.get("count", 0))
         elif op == "closed":
             child.closed.set()
+
+    def _on_batch(self, child: _Child, batch: LiveBatch) -> None:
+        self.mirrors.apply(batch)
+        if batch.final:
+            with self._lock:
+                child.runs.discard(batch.run_id)
+                if self._where.get(batch.run_id) is child:
+                    del self._where[batch.run_id]
 
     def _lost(self, child: _Child) -> None:
         """The child ended: if it still held runs, they failed with it; start another."""

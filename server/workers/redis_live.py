@@ -9,8 +9,9 @@ Keys and channels (all under "robodojo:"), per run:
     cmd:<run_id>        PUBLISH a CommandRequest; only the worker holding the run subscribes
     answer:<request_id> LPUSH the CommandAnswer (expires); the web process BLPOPs it
 
-A batch's writes go in one MULTI/EXEC, so a web process reading the three keys (also in one
-MULTI) sees the run as of one batch, and skips published batches it already has by their seq.
+A worker's publisher round (every run's batch) goes in one MULTI/EXEC, so a web process reading
+the three keys (also in one MULTI) sees the run as of one batch, and skips published batches it
+already has by their seq.
 Everything expires: a worker that died leaves nothing behind for long.
 
     outlet = RedisOutlet(client)                 # worker: RunHost(..., outlet=outlet)
@@ -23,7 +24,7 @@ import logging
 import threading
 import time
 import uuid
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import redis
@@ -92,9 +93,11 @@ def run_id_of(channel: bytes | str, prefix: str) -> str:
 
 # ------------------------------------------------------------------------------ worker side
 class RedisOutlet:
-    """A worker's LiveOutlet: each batch published and kept (newest status, newest sample per
-    topic, recent events) in one transaction. Never raises: while Redis is away batches are
-    dropped (the run goes on; its end is in the database) and that is logged now and then."""
+    """A worker's LiveOutlet: each round's batches published and kept (newest status, newest
+    sample per topic, recent events) in one MULTI/EXEC, one round trip for every run of the
+    worker. Never raises: a batch JSON refuses is left out and logged; while Redis is away
+    batches are dropped (the run goes on; its end is in the database) and that is logged now
+    and then."""
 
     def __init__(self, client: redis.Redis) -> None:
         self.client = client
@@ -104,48 +107,73 @@ class RedisOutlet:
         self.dropped = 0  # batches lost while Redis was away
 
     def publish(self, batch: LiveBatch) -> None:
-        with self._lock:
-            seq = self._seqs.get(batch.run_id, 0) + 1
-            if batch.final:
-                self._seqs.pop(batch.run_id, None)
-            else:
-                self._seqs[batch.run_id] = seq
+        self.publish_round([batch])
+
+    def publish_round(self, batches: Sequence[LiveBatch]) -> None:
+        pipe = self.client.pipeline(transaction=True)
+        queued = 0
+        for batch in batches:
+            with self._lock:
+                seq = self._seqs.get(batch.run_id, 0) + 1
+                if batch.final:
+                    self._seqs.pop(batch.run_id, None)
+                else:
+                    self._seqs[batch.run_id] = seq
+            try:
+                queue_batch(pipe, batch, seq)
+            except ValueError as error:  # a NaN: this batch cannot go, the others can
+                log.error(
+                    "run %s: a live batch is not JSON and was dropped: %s", batch.run_id, error
+                )
+                continue
+            queued += 1
+        if not queued:
+            return
         try:
-            write_batch(self.client, batch, seq)
+            pipe.execute()
         except redis.RedisError as error:
-            self.dropped += 1
+            self.dropped += queued
             now = time.monotonic()
             if now - self._last_complaint > LOG_EVERY_S:
                 self._last_complaint = now
                 log.warning(
-                    "live traffic of run %s not sent: Redis is away (%s); runs go on, viewers "
+                    "live traffic of %d runs not sent: Redis is away (%s); runs go on, viewers "
                     "catch up when it is back",
-                    batch.run_id,
+                    queued,
                     error,
                 )
 
 
 def write_batch(client: redis.Redis, batch: LiveBatch, seq: int) -> None:
     """Publish one batch and keep what a late viewer needs, in one MULTI/EXEC."""
+    pipe = client.pipeline(transaction=True)
+    queue_batch(pipe, batch, seq)
+    pipe.execute()
+
+
+def queue_batch(pipe: redis.client.Pipeline, batch: LiveBatch, seq: int) -> None:
+    """Queue on `pipe` one batch's publication and what a late viewer needs of it. Raises
+    ValueError (and queues nothing) when the batch is not JSON (a NaN)."""
     run_id = batch.run_id
     ttl = KEEP_AFTER_END_S if batch.final else LIVE_TTL_S
     data = batch_to_json(batch)
-    pipe = client.pipeline(transaction=True)
-    pipe.publish(live_channel(run_id), dumps({"seq": seq, "batch": data}))
+    published = dumps({"seq": seq, "batch": data})  # first: a NaN anywhere refuses it here
     fields: dict[str, Any] = {"seq": seq}
     if data["status"] is not None:
         fields["status"] = dumps(data["status"])
     if batch.final:
         fields["final"] = 1
+    # [topic, type, time_ns, base64, wall_s, skipped] each
+    latest = {s[0]: dumps(s) for s in data["samples"]}
+    pipe.publish(live_channel(run_id), published)
     pipe.hset(run_key(run_id), mapping=fields)
-    if data["samples"]:  # [topic, type, time_ns, base64, wall_s, skipped] each
-        pipe.hset(latest_key(run_id), mapping={s[0]: dumps(s) for s in data["samples"]})
+    if latest:
+        pipe.hset(latest_key(run_id), mapping=latest)
     if batch.events or batch.final:
         entry = {"seq": seq, "events": dumps({"e": list(batch.events)}), "final": int(batch.final)}
         pipe.xadd(events_key(run_id), entry, maxlen=EVENT_BATCHES_KEPT, approximate=True)
     for key in (run_key(run_id), latest_key(run_id), events_key(run_id)):
         pipe.expire(key, ttl)  # renewed while the run sends; a dead worker's keys vanish
-    pipe.execute()
 
 
 def publish_end(client: redis.Redis, run_id: str, state: str, reason: str) -> None:

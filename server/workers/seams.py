@@ -12,6 +12,7 @@ Routes, the websocket, the 3D view and the hub still talk only to RunService
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Protocol
 
 from server.runs.commands import RunCommand
@@ -27,10 +28,12 @@ class ExecutorUnavailableError(RuntimeError):
 class LiveOutlet(Protocol):
     """Where a worker's RunHost sends each run's live traffic (a pipe to the web process, Redis
     pub/sub, or straight into a RunTelemetry in-process). Called from the host's publisher
-    thread; must not block for long and must not raise (a lost batch is logged, the run goes
-    on: telemetry is latest-wins anyway, and the end is also in the database)."""
+    thread, once a round with every run's batch of that round (at most one per run), so an
+    outlet can send a round in one write: one pipe message, one Redis round trip. Must not
+    block for long and must not raise (a lost batch is logged, the others still go, the run
+    goes on: telemetry is latest-wins anyway, and the end is also in the database)."""
 
-    def publish(self, batch: LiveBatch) -> None: ...
+    def publish_round(self, batches: Sequence[LiveBatch]) -> None: ...
 
 
 class RunExecutor(Protocol):

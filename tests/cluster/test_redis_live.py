@@ -5,6 +5,8 @@ survived (listeners reconnect; commands while it is down get a sentence, never a
 
 from __future__ import annotations
 
+import logging
+import math
 import threading
 import time
 
@@ -19,9 +21,11 @@ from server.workers.redis_live import (
     LiveSubscriber,
     RedisOutlet,
     command_channel,
+    latest_key,
     live_channel,
     publish_end,
     read_snapshot,
+    run_key,
     send_command,
 )
 from server.workers.seams import ExecutorUnavailableError
@@ -109,6 +113,31 @@ def test_batches_reach_a_watcher_in_order_once_and_it_stops_after_the_final(clie
     outlet.publish(LiveBatch("run1", events=({"type": "log", "line": "after the end"},)))
     time.sleep(0.2)  # nothing may arrive: this wait is the behaviour under test
     assert "after the end" not in str(applied.events())
+
+
+def test_a_round_of_many_runs_goes_in_one_transaction_and_a_bad_batch_stays_out(
+    client, subscriber, caplog
+):
+    outlet = RedisOutlet(client)
+    for run_id in ("runA", "runB", "runC"):
+        assert subscriber.watch(run_id, wait_s=30.0)
+    bad = LiveBatch("runB", events=({"type": "log", "line": "x", "gain": math.nan},))
+    with caplog.at_level(logging.ERROR, logger="robodojo.workers.live"):
+        outlet.publish_round([
+            LiveBatch("runA", samples=(sample("Distance", 1),)),
+            bad,
+            LiveBatch("runC", samples=(sample("Distance", 3),), status=status("runC")),
+        ])  # fmt: skip
+    applied = subscriber.applied
+    wait_until(lambda: {b.run_id for b in applied.batches} >= {"runA", "runC"}, 10,
+               "the good batches arrived")  # fmt: skip
+    assert "run runB: a live batch is not JSON" in caplog.text
+    assert not client.exists(run_key("runB"))  # nothing of it was kept either
+    assert client.hget(run_key("runC"), "seq") == b"1"
+    assert client.ttl(latest_key("runA")) > 0  # everything expires, as for a lone batch
+    # The run whose batch was refused goes on: its next batch is published and applied.
+    outlet.publish(LiveBatch("runB", events=({"type": "log", "line": "fine again"},)))
+    wait_until(lambda: "fine again" in str(applied.events()), 10, "runB's next batch arrived")
 
 
 def test_a_viewer_starting_mid_run_gets_the_newest_of_everything_then_the_rest(client, subscriber):
