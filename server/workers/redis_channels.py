@@ -99,9 +99,12 @@ class ChannelListener:
             pubsub = self.client.pubsub()
             try:
                 self._listen(pubsub)
-            except (redis.RedisError, OSError) as error:
-                if self.connected:
-                    log.warning("%s: lost Redis (%s); reconnecting", self.name, error)
+            except Exception as error:  # this thread must outlive anything
+                if isinstance(error, redis.RedisError | OSError):
+                    if self.connected:
+                        log.warning("%s: lost Redis (%s); reconnecting", self.name, error)
+                else:  # a fault of the client library or ours: said in full, then go on
+                    log.exception("%s: the listener failed; starting it again", self.name)
                 self.connected = False
                 with self._lock:
                     self._confirmed.clear()
@@ -110,7 +113,7 @@ class ChannelListener:
             else:
                 delay = RECONNECT_FIRST_S
             finally:
-                with contextlib.suppress(redis.RedisError, OSError):
+                with contextlib.suppress(Exception):  # a broken connection: nothing to close
                     pubsub.close()
 
     def _listen(self, pubsub: redis.client.PubSub) -> None:

@@ -206,6 +206,31 @@ def test_a_subscription_dropped_by_its_own_catch_up_still_counts_as_confirmed(cl
         listener.stop()
 
 
+def test_a_listener_outlives_a_fault_that_is_not_redis_s_and_confirms_again(
+    client, monkeypatch, caplog
+):
+    # A fault inside the client library (or ours) used to end the listener's thread for good:
+    # every later subscription of that process then waited in vain.
+    real = redis.client.PubSub.get_message
+    faults = [ValueError("a reply the client could not parse")]
+
+    def get_message(self, *args, **kwargs):
+        if faults:
+            raise faults.pop()
+        return real(self, *args, **kwargs)
+
+    monkeypatch.setattr(redis.client.PubSub, "get_message", get_message)
+    listener = ChannelListener(client, handle=lambda channel, data: None, name="test")
+    with caplog.at_level(logging.ERROR, logger="robodojo.workers.channels"):
+        listener.start()
+        try:
+            assert listener.add("robodojo:test:after-a-fault", wait_s=10.0)
+            assert not faults
+        finally:
+            listener.stop()
+    assert "test: the listener failed; starting it again" in caplog.text
+
+
 @pytest.fixture
 def worker_ear(client):
     seen: list[CommandRequest] = []
