@@ -124,3 +124,22 @@ def queued_run(store: Store, run_dir: Path, state: str = "created") -> str:
             ),
         )
     return run_id
+
+
+LAST_LINES_ON_FAILURE = 60  # of each web process and worker: enough to see what went wrong
+
+
+@pytest.hookimpl(wrapper=True)
+def pytest_runtest_makereport(item, call):
+    """A failed cluster test shows what its processes said last: a web process or worker that
+    logged a fault is the likeliest witness of a failure seen only from outside."""
+    report = yield
+    lab = item.funcargs.get("cluster") if report.when == "call" and report.failed else None
+    if lab is not None:
+        for index, web in enumerate(lab.webs):
+            lines = "\n".join(web.output[-LAST_LINES_ON_FAILURE:])
+            report.sections.append((f"web process {index}, last lines", lines))
+        for index, worker in enumerate(lab.workers):
+            lines = "\n".join(worker.output[-LAST_LINES_ON_FAILURE:])
+            report.sections.append((f"worker {index}, last lines", lines))
+    return report
