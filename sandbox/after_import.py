@@ -86,19 +86,12 @@ class _MetaPathHook:
             sys.meta_path.remove(self)
 
 
-class AfterImport(_MetaPathHook):
-    """Calls `patch(module)` once `name` is imported (at once if it already is)."""
+class _OneModuleHook(_MetaPathHook):
+    """A finder for one module: the first time it is searched for, the hook takes itself out,
+    lets the finders below find it and hands their spec to `_wrap` (to change its loader)."""
 
-    def __init__(self, name: str, patch: Patch) -> None:
+    def __init__(self, name: str) -> None:
         self.name = name
-        self._patch = patch
-
-    def install(self) -> None:
-        module = sys.modules.get(self.name)
-        if module is not None:
-            self._patch(module)
-            return
-        super().install()
 
     def find_spec(
         self,
@@ -110,9 +103,31 @@ class AfterImport(_MetaPathHook):
             return None
         self.remove()  # once is enough, and the finders below must not find us again
         spec = _find_spec_below(fullname, path, target)
-        if spec is not None and spec.loader is not None:
-            spec.loader = _PatchingLoader(spec.loader, self._patch)
+        if spec is not None:
+            self._wrap(spec)
         return spec
+
+    def _wrap(self, spec: importlib.machinery.ModuleSpec) -> None:
+        raise NotImplementedError
+
+
+class AfterImport(_OneModuleHook):
+    """Calls `patch(module)` once `name` is imported (at once if it already is)."""
+
+    def __init__(self, name: str, patch: Patch) -> None:
+        super().__init__(name)
+        self._patch = patch
+
+    def install(self) -> None:
+        module = sys.modules.get(self.name)
+        if module is not None:
+            self._patch(module)
+            return
+        super().install()
+
+    def _wrap(self, spec: importlib.machinery.ModuleSpec) -> None:
+        if spec.loader is not None:
+            spec.loader = _PatchingLoader(spec.loader, self._patch)
 
 
 class BeforeImport(_MetaPathHook):
@@ -206,28 +221,18 @@ class _DeferringLoader:
         return getattr(self._inner, name)
 
 
-class DeferredImport(_MetaPathHook):
+class DeferredImport(_OneModuleHook):
     """Makes the next import of `name` bind the module at once and run its code at its first
     use, inside `with loading():` (nothing happens if `name` is imported already)."""
 
     def __init__(self, name: str, loading: Loading) -> None:
-        self.name = name
+        super().__init__(name)
         self._loading = loading
 
     def install(self) -> None:
         if self.name not in sys.modules:
             super().install()
 
-    def find_spec(
-        self,
-        fullname: str,
-        path: Sequence[str] | None,
-        target: types.ModuleType | None = None,
-    ) -> importlib.machinery.ModuleSpec | None:
-        if fullname != self.name:
-            return None
-        self.remove()  # once is enough, and the finders below must not find us again
-        spec = _find_spec_below(fullname, path, target)
-        if spec is not None and hasattr(spec.loader, "exec_module"):
+    def _wrap(self, spec: importlib.machinery.ModuleSpec) -> None:
+        if hasattr(spec.loader, "exec_module"):
             spec.loader = _DeferringLoader(spec.loader, self._loading)
-        return spec

@@ -153,11 +153,8 @@ class Launcher:
 def _checked_message_types(names: Iterable[str]) -> tuple[str, ...]:
     """The names, once each is known to have a class in both dialects: a name we do not
     provide fails here, with the message types' own sentence, not in every warm process."""
-    from sandbox.msgs import get_message_class
-    from sandbox.msgs2.bridge import ros2_name
+    from sandbox.msgs2.bridge import build_both_dialects
 
     checked = tuple(dict.fromkeys(names))
-    for name in checked:
-        get_message_class(name)
-        get_message_class(ros2_name(name))
+    build_both_dialects(checked)
     return checked

