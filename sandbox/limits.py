@@ -27,6 +27,11 @@ class Limits:
     # spinning node cannot take both cores of a 2-core lab machine from the server and the others.
     cpu_quota_us: int = 100_000
     cpu_period_us: int = 100_000
+    # Scheduling niceness of a node process (the lab's own processes run at 0). When the machine
+    # is busy, the realtime scheduler that wakes every run and the web process serving the class
+    # get a core before students' code does; a node still gets its share (~1/3 of a nice-0
+    # process's at 5). The warm pool's refills, ~1 s of imports each, yield the same way.
+    nice: int = 5
     # CPU seconds for the node's whole life: a run of several minutes at a few percent CPU fits
     # easily; a spinning node is killed by the step budget long before this.
     cpu_seconds: int = 900

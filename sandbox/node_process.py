@@ -105,6 +105,7 @@ class NodeProcess:
         # through bwrap), so nothing has to be moved between fork and exec.
         settings = {
             "rlimits": _rlimits(limits),
+            "nice": limits.nice,
             "seal": sandboxed,
             "preload": preload,
             "message_types": list(message_types),

@@ -1,8 +1,8 @@
 """The child side of a sandboxed node: the program bubblewrap starts.
 
 Runs inside the sandbox (see sandbox/launcher.py for the walls). In order:
-1. lower its own rlimits to the values the launcher passed (before any import, so the imports
-   count against the address-space cap);
+1. lower its own rlimits to the values the launcher passed, and its priority (`nice`), before
+   any import (so the imports count against the address-space cap);
 2. import the node host (the message types, the rospy shim: light), and, in a process meant for
    the warm pool only (`preload` in the settings), what controllers use too (numpy, matplotlib
    with the Agg backend, scipy, scikit-fuzzy, rclpy) and the classes of the robots' message
@@ -120,6 +120,7 @@ def main(argv: list[str] | None = None) -> int:
     args = argv if argv is not None else sys.argv[1:]
     settings = json.loads(args[0]) if args else {}
     _apply_rlimits(settings.get("rlimits", {}))
+    os.nice(int(settings.get("nice", 0)))  # lower priority only: allowed without privileges
     _seed_font_cache()  # before any matplotlib import, ours or the student's
     _host_imports()
     if settings.get("preload", True):

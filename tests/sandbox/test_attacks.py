@@ -326,6 +326,26 @@ def test_broken_code_comes_back_readable(launcher, code, error_type, line):
     assert "/opt/robodojo" not in exited.error.traceback
 
 
+def test_a_node_runs_below_the_lab_s_priority_and_cannot_raise_it(launcher):
+    # The realtime scheduler and the web process come first on a busy machine (limits.nice);
+    # a student cannot take that back.
+    code = (
+        "import os\n"
+        "nice = int(open('/proc/self/stat').read().rsplit(')', 1)[1].split()[16])\n"
+        "try:\n"
+        "    os.setpriority(os.PRIO_PROCESS, 0, 0)\n"
+        "    tried = 'allowed'\n"
+        "except OSError as error:\n"
+        "    tried = type(error).__name__\n"
+        "raise RuntimeError(f'nice={nice} back to 0: {tried}')\n"
+    )
+    assert DEFAULT_LIMITS.nice > 0
+    exited = finish(launcher, code)
+    assert error_text(exited) == (
+        f"RuntimeError: nice={DEFAULT_LIMITS.nice} back to 0: PermissionError"
+    )
+
+
 @pytest.mark.slow
 def test_touched_memory_is_capped_by_the_cgroup_or_the_rlimit(launcher):
     code = (
