@@ -340,14 +340,16 @@ class CrowBotFirmware:
         self.receiver = RosLibReceiver(self.options.protocol_version)
 
     def _close(self) -> None:
-        with self._write_lock:
-            sock, self._sock = self._sock, None
-            if sock is not None:
-                sock.close()
+        # The flags go down before the socket closes: a peer that sees the close (a test
+        # reading until EOF) must find the firmware already disconnected, not race its thread.
         if self.connected:
             self.connected = False
             self.disconnects += 1
         self.configured = False
+        with self._write_lock:
+            sock, self._sock = self._sock, None
+            if sock is not None:
+                sock.close()
 
     def _write(self, data: bytes) -> None:
         with self._write_lock:
