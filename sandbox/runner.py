@@ -92,13 +92,6 @@ def _warm_rclpy() -> None:
         set_aside_modules_from(ROS_COMPAT2_DIR)
 
 
-def _warm_message_classes(names: list[str]) -> None:
-    """Build the classes of these ROS 1 types and their ROS 2 twins now, not at first use."""
-    from sandbox.msgs2.bridge import build_both_dialects
-
-    build_both_dialects(names)
-
-
 class PipeLink:
     """The node host's view of the parent: whole frames over the protocol pipes."""
 
@@ -125,7 +118,9 @@ def main(argv: list[str] | None = None) -> int:
     _host_imports()
     if settings.get("preload", True):
         _warm_imports()
-        _warm_message_classes(settings.get("message_types", []))
+        from sandbox.msgs2.bridge import build_both_dialects
+
+        build_both_dialects(settings.get("message_types", []))
     if settings.get("seal", True):
         from sandbox.seccomp import install_stage2
 

@@ -73,9 +73,10 @@ import json
 from sandbox import runner
 from sandbox.msgs import _core as ros1
 from sandbox.msgs2 import _core as ros2
+from sandbox.msgs2.bridge import build_both_dialects
 runner._host_imports()
 before = ["sensor_msgs/LaserScan" in ros1._REGISTRY, "sensor_msgs/msg/LaserScan" in ros2._REGISTRY]
-runner._warm_message_classes(["sensor_msgs/LaserScan"])
+build_both_dialects(["sensor_msgs/LaserScan"])  # as the runner does for its warm pool
 after = ["sensor_msgs/LaserScan" in ros1._REGISTRY, "sensor_msgs/msg/LaserScan" in ros2._REGISTRY]
 print(json.dumps({"before": before, "after": after}))
 """
