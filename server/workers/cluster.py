@@ -181,18 +181,20 @@ class QueueExecutor:
 
     # ------------------------------------------------------------------------------ following
     def _follow(self, run_id: str) -> bool:
-        """Follow a run's live traffic here: True for a run Redis knows or still queued (its
+        """Follow a run's live traffic here: True for a run Redis knows or not yet ended (its
         mirror fills when the subscription is confirmed, normally within milliseconds; this
         waits up to FIRST_SNAPSHOT_WAIT_S for that, no longer: a loaded machine is slower).
-        False for a run neither in Redis nor queued (long over, or unknown), or Redis away."""
+        False for a run Redis does not know that has ended (long over) or is unknown, or Redis
+        away. A run a worker has claimed ("starting") but not yet published counts as not
+        ended: a viewer arriving then used to be told at once that the run was over."""
         try:
             known = self.client.exists(run_key(run_id))
         except redis.RedisError:
             return False
-        if not known:
+        if not known:  # queued, or claimed by a worker that has not published yet
             with self.store.session() as db:
                 record = run_store.get(db, run_id)
-                if record is None or record.state != str(RunState.CREATED):
+                if record is None or RunState(record.state).is_end:
                     return False
         with self._lock:
             self._last_heard.setdefault(run_id, time.monotonic())

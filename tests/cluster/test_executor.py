@@ -19,7 +19,7 @@ from server.store.workers import WorkerReport
 from server.workers import cluster as cluster_module
 from server.workers.cluster import QueueExecutor, queued_key
 from server.workers.queue import JobTaker, declare_actor, make_broker, make_worker, requeuer
-from server.workers.redis_live import CommandListener, RedisOutlet
+from server.workers.redis_live import CommandListener, RedisOutlet, run_key
 from server.workers.wire import CommandAnswer, LiveBatch, RunJob
 from tests.cluster.conftest import queued_run
 from tests.cluster.test_queue import job_for
@@ -146,6 +146,19 @@ def test_commands_status_and_feed_reach_a_run_on_a_worker(
     wait_until(lambda: not executor.is_running(run_id), 10, "it is no longer running")
     assert stand_in.executed == [run_id]
     assert not executor.command(run_id, Button(pressed=True))
+
+
+def test_a_run_claimed_but_not_yet_published_can_be_watched(executor, sqlite_store, tmp_path):
+    # Between a worker's claim and its first batch (the run being built, its nodes starting:
+    # seconds on a loaded machine) a viewer must get a feed, not "the run is over".
+    run_id = queued_run(sqlite_store, tmp_path)
+    with sqlite_store.session() as db:
+        assert run_store.claim(db, run_id, "busy:1")
+        assert run_store.get(db, run_id).state == "starting"
+    assert not executor.client.exists(run_key(run_id))
+    assert executor.feed(run_id) is not None
+    ended = queued_run(sqlite_store, tmp_path, state="finished")
+    assert executor.feed(ended) is None  # over, and Redis knows nothing of it: no feed
 
 
 def test_a_lost_workers_run_is_ended_for_its_viewers(executor, sqlite_store, tmp_path):
