@@ -16,6 +16,8 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
+import msgspec
+
 from sandbox.protocol import Api, Clock
 from server.runs.commands import CommandError, RunCommand, command_dict, parse_command
 from server.runs.spec import NodeSpec, RunSpec
@@ -319,8 +321,11 @@ def dumps(data: dict[str, Any]) -> bytes:
 
 
 def loads(raw: bytes | str) -> Any:
+    """The value of JSON bytes or text. msgspec reads it: 1.6 us for a 1.7 KB live batch where
+    `json` took 5.5 (every batch of every viewed run is read on the web side); like `dumps` it
+    refuses NaN and infinities."""
     try:
-        return json.loads(raw)
+        return msgspec.json.decode(raw)
     except (ValueError, UnicodeDecodeError) as error:
         raise WireError(f"a message on the wire is not JSON: {error}") from None
 

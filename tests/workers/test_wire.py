@@ -127,3 +127,15 @@ def test_pickles_are_not_json() -> None:
 
     with pytest.raises(WireError, match="not JSON"):
         loads(pickle.dumps({"run_id": "r"}))
+
+
+@pytest.mark.parametrize("raw", [b'{"x": NaN}', b'{"x": Infinity}', b'{"x": 1', b"", "\ufeff{}"])
+def test_what_dumps_would_never_write_is_not_read_either(raw) -> None:
+    with pytest.raises(WireError, match="not JSON"):
+        loads(raw)
+
+
+def test_loads_reads_back_what_dumps_wrote() -> None:
+    value = {"run_id": "r", "samples": [["odom", "nav_msgs/Odometry", 2**62, "AAE=", 1.5, 0]]}
+    assert loads(dumps(value)) == value
+    assert loads(dumps(value).decode()) == value
