@@ -254,6 +254,85 @@ async def sample_memory_every(
         await asyncio.sleep(every_s)
 
 
+# ------------------------------------------------------------------------------ the machine
+# One pass of the reference workload: pure-Python integer additions, what the lab's scheduler
+# and nodes mostly do. The lab machines of one kind differ by up to 2x in it (a loop of 10 M
+# additions took 0.4-1.06 s on them, on a quiet machine), and every latency figure with it.
+SPEED_LOOP_ADDITIONS = 2_000_000
+SPEED_REPEATS = 7
+
+
+def machine_speed_ms() -> float:
+    """[ms] median time of the reference workload on one core (lower is faster). Printed
+    beside a benchmark's figures, so passes on different machines can be compared."""
+    times = []
+    for _ in range(SPEED_REPEATS):
+        started = time.perf_counter()
+        total = 0
+        for number in range(SPEED_LOOP_ADDITIONS):
+            total += number
+        times.append(time.perf_counter() - started)
+    return statistics.median(times) * 1e3
+
+
+PING_ROUND_TRIPS = 2000
+
+
+def pipe_round_trip_us() -> float:
+    """[us] median round trip of one byte between this process and a forked child over two
+    pipes: the system calls and wake-ups every node step and realtime wake pays, which the
+    reference loop does not exercise (two machines of one kind with the same loop time spent
+    3.4-3.7% and 5.7-7.0% of a core per 100 Hz run)."""
+    to_child_r, to_child_w = os.pipe()
+    to_parent_r, to_parent_w = os.pipe()
+    child = os.fork()
+    if child == 0:  # echo until the parent closes its end
+        try:
+            os.close(to_child_w)
+            os.close(to_parent_r)
+            while os.read(to_child_r, 1):
+                os.write(to_parent_w, b"!")
+        finally:
+            os._exit(0)
+    os.close(to_child_r)
+    os.close(to_parent_w)
+    times = []
+    for _ in range(PING_ROUND_TRIPS):
+        started = time.perf_counter()
+        os.write(to_child_w, b"?")
+        os.read(to_parent_r, 1)
+        times.append(time.perf_counter() - started)
+    os.close(to_child_w)
+    os.close(to_parent_r)
+    os.waitpid(child, 0)
+    return statistics.median(times) * 1e6
+
+
+def machine_shares(before) -> tuple[float, float]:
+    """(% of the machine busy, % of it the host took back: steal) since `before`, an earlier
+    psutil.cpu_times()."""
+    after = psutil.cpu_times()
+    idle = (after.idle + after.iowait) - (before.idle + before.iowait)
+    total = sum(after) - sum(before)
+    if total <= 0:
+        return math.nan, math.nan
+    steal = getattr(after, "steal", 0.0) - getattr(before, "steal", 0.0)
+    return 100.0 * (1.0 - idle / total), 100.0 * steal / total
+
+
+def describe_machine() -> str:
+    """A line naming how fast this machine is now and how much of it the host takes back."""
+    before = psutil.cpu_times()
+    speed_ms = machine_speed_ms()
+    ping_us = pipe_round_trip_us()
+    _, steal_percent = machine_shares(before)
+    return (
+        f"machine: {psutil.cpu_count()} cores; reference loop ({SPEED_LOOP_ADDITIONS:,} "
+        f"additions) {speed_ms:.0f} ms median, pipe round trip {ping_us:.1f} us median, steal "
+        f"{steal_percent:.1f}% meanwhile"
+    )
+
+
 # ------------------------------------------------------------------------------ figures
 def percentile(values, q: float) -> float:
     ordered = sorted(values)

@@ -37,6 +37,7 @@ from _common import (
     Window,
     bearer,
     loop_lag,
+    machine_shares,
     percentile,
     poll_status,
     row,
@@ -114,7 +115,7 @@ async def class_pass(
         window.start = time.monotonic()
         await asyncio.sleep(measure_s)
         window.end = time.monotonic()
-        busy = _busy_percent(busy_before)
+        busy, steal = machine_shares(busy_before)
         cpu_after = await asyncio.to_thread(tree_cpu_s, lab_processes)
         used_s = sum(cpu_after[pid] - cpu_before[pid] for pid in cpu_after if pid in cpu_before)
         cores_per_run = used_s / (window.end - window.start) / count
@@ -136,6 +137,7 @@ async def class_pass(
         await stop_runs(runs)
     await wait_ended(runs, END_TIMEOUT_S)
     return _pass_figures(runs, viewers, http, loop_lags, rate_hz, ramp_s, measure_s, busy) | {
+        "machine_steal_percent": steal,
         "memory_per_run_mib": (pss_during - idle_pss) / count,
         "cores_per_run": cores_per_run,  # web, workers and sandboxes, over the window
         "web_cores": web_cores,  # the web processes themselves (no children), all together
@@ -160,13 +162,6 @@ async def wait_refilled(web: Web, admin_token: str, full: int, timeout_s: float)
             break
         await asyncio.sleep(0.5)
     return time.monotonic() - started
-
-
-def _busy_percent(before) -> float:
-    after = psutil.cpu_times()
-    idle = (after.idle + after.iowait) - (before.idle + before.iowait)
-    total = sum(after) - sum(before)
-    return 100.0 * (1.0 - idle / total) if total > 0 else math.nan
 
 
 def _pass_figures(
@@ -219,7 +214,8 @@ def report_pass(name: str, figures: dict) -> None:
         f"{name}: {figures['runs']} realtime runs at {figures['rate_hz']:g} Hz (period "
         f"{period_ms:.1f} ms, limit {limit_ms:.1f} ms), all running after {figures['ramp_s']:.0f}"
         f" s, measured {figures['measured_s']:.0f} s; machine {figures['machine_busy_percent']:.0f}"
-        f"% busy, load {figures['load_1min']:.1f}"
+        f"% busy (steal {figures.get('machine_steal_percent', math.nan):.1f}%), load "
+        f"{figures['load_1min']:.1f}"
     )
     print(f"  {'[ms]':<56} {'p50':>8} {'p99':>8} {'max':>8} {'n':>9}")
     row("  period p99 per run, steady (newest 1000 wakes)", [x / 1e3 for x in steady])

@@ -27,8 +27,11 @@ period p99 within 10% of the period (doubling from --sweep-start, then halving t
 --sweep-steps times); divided by the cores, the runs one worker core holds.
 
 Each scenario runs --repeats (2) times, each in a fresh lab; the last lines give both passes
-and their median. --json FILE appends every figure as one JSON line per pass. --label marks
-the figures (e.g. "loaded" while the machine is shared).
+and their median. The first line and the summary name the machine's speed before and after
+(bench/_common.py describe_machine: the same 2-core machine kind ran its reference loop in 62
+to 129 ms within one hour), so figures from different machines or hours can be compared.
+--json FILE appends every figure as one JSON line per pass. --label marks the figures (e.g.
+"loaded" while the machine is shared).
 
 Usage: python bench/bench_cluster.py --mode cluster [--scenarios a,b,c] [--repeats 2]
        [--minutes 10] [--measure 60] [--sweep 10,20,50,100] [--label loaded] [--json out.jsonl]
@@ -52,7 +55,13 @@ from pathlib import Path
 import _heap
 import httpx
 from _class import Web
-from _common import HTTP_TIMEOUT_S, MAX_HTTP_IN_FLIGHT, BenchError, stop_on_sigterm
+from _common import (
+    HTTP_TIMEOUT_S,
+    MAX_HTTP_IN_FLIGHT,
+    BenchError,
+    describe_machine,
+    stop_on_sigterm,
+)
 from _lab import MODES, Lab, open_lab
 from _scenarios import (
     ENV,
@@ -158,6 +167,7 @@ async def one_pass(lab: Lab, args: argparse.Namespace, number: int) -> dict[str,
 
 def summarize(passes: list[dict[str, dict]], args: argparse.Namespace) -> None:
     print(f"\n[{args.label}] {args.mode_label}: both passes and their median")
+    print(f"  before: {args.machine}\n  after:  {describe_machine()}")
     for scenario in ("a", "b"):
         heads = [headline(p[scenario]) for p in passes if scenario in p]
         if not heads:
@@ -201,7 +211,13 @@ def save(path: Path, args: argparse.Namespace, number: int, results: dict[str, d
         if name in ("a", "b"):
             kept["headline"] = headline(figures)
         slim[name] = kept
-    line = {"label": args.label, "mode": args.mode_label, "pass": number, "results": slim}
+    line = {
+        "label": args.label,
+        "mode": args.mode_label,
+        "machine": args.machine,
+        "pass": number,
+        "results": slim,
+    }
     with path.open("a") as f:
         f.write(json.dumps(line, default=str) + "\n")
 
@@ -259,6 +275,8 @@ def main() -> None:
     workers = "default" if args.workers is None else args.workers
     args.mode_label = args.mode if args.mode == "cluster" else f"single, --workers {workers}"
     stop_on_sigterm()
+    args.machine = describe_machine()  # before the lab: the machine alone
+    print(args.machine, flush=True)
     passes = []
     for number in range(1, args.repeats + 1):
         with tempfile.TemporaryDirectory(prefix="robodojo-bench-cluster-") as data:

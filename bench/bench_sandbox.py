@@ -30,6 +30,8 @@ import subprocess
 import sys
 import time
 
+from _common import describe_machine  # first: it puts this checkout on sys.path
+
 from sandbox.launcher import Launcher
 from sandbox.protocol import Api, Clock, Envelope, NodeInfo, RobotTopic, Yield
 from server.sim.registry import topic_types
@@ -202,6 +204,7 @@ def main() -> None:
     parser.add_argument("--no-jupyter", action="store_true")
     parser.add_argument("--starts-only", action="store_true", help="only the start times")
     args = parser.parse_args()
+    print(describe_machine(), flush=True)
     bench_starts(args.starts)
     if args.starts_only:
         return
