@@ -17,6 +17,7 @@ import ast
 import os
 import re
 
+from sandbox import python_ast
 from sandbox.launch2.errors import LaunchError, PackageNotFoundError, Site
 
 MAX_SCAN_DEPTH = 4  # folders below the workspace searched for package.xml and node files
@@ -103,7 +104,7 @@ def _console_scripts(setup_py: str) -> dict[str, str]:
     (only literal values are understood)."""
     try:
         with open(setup_py, encoding="utf-8", errors="replace") as file:
-            tree = ast.parse(file.read())
+            tree = python_ast.parse(file.read())
     except (OSError, SyntaxError, ValueError):
         return {}
     scripts: dict[str, str] = {}
@@ -114,7 +115,7 @@ def _console_scripts(setup_py: str) -> dict[str, str]:
             if keyword.arg != "entry_points":
                 continue
             try:
-                entry_points = ast.literal_eval(keyword.value)
+                entry_points = ast.literal_eval(keyword.value)  # a tree, no text
             except ValueError:
                 continue
             if not isinstance(entry_points, dict):
@@ -184,7 +185,7 @@ def runs_entry_itself(path: str) -> bool:
     point itself when run as a script)."""
     try:
         with open(os.path.join(workdir(), path), encoding="utf-8", errors="replace") as file:
-            tree = ast.parse(file.read())
+            tree = python_ast.parse(file.read())
     except (OSError, SyntaxError, ValueError):
         return True  # the node reports its own syntax error when it runs
     for node in tree.body:
@@ -198,7 +199,7 @@ def node_name_in_code(path: str) -> str | None:
     `super().__init__('talker')`, `Node('talker')`, `rclpy.create_node('talker')`."""
     try:
         with open(os.path.join(workdir(), path), encoding="utf-8", errors="replace") as file:
-            tree = ast.parse(file.read())
+            tree = python_ast.parse(file.read())
     except (OSError, SyntaxError, ValueError):
         return None
     names: set[str] = set()

@@ -14,11 +14,12 @@ rosidl_generator_py's ``generate_py_impl.py`` (``SPECIAL_NESTED_BASIC_TYPES``,
 
 from __future__ import annotations
 
-import ast
 import re
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
+
+from sandbox import python_ast
 
 
 @dataclass(frozen=True)
@@ -158,7 +159,7 @@ def _literal(msg_type: str, base: str, text: str, where: str) -> Any:
     if base == "string":
         text = text.strip()
         if len(text) >= 2 and text[0] == text[-1] and text[0] in "'\"":
-            return ast.literal_eval(text)
+            return python_ast.literal_eval(text)
         return text
     text = text.strip()
     if primitive.python == "bool":
@@ -178,7 +179,7 @@ def _literal(msg_type: str, base: str, text: str, where: str) -> Any:
 def _default(msg_type: str, field: FieldSpec, text: str) -> Any:
     if field.container is None:
         return _literal(msg_type, field.base, text, f"default of {field.name}")
-    items = ast.literal_eval(text.strip())
+    items = python_ast.literal_eval(text.strip())
     return [
         _literal(msg_type, field.base, repr(item), f"default of {field.name}") for item in items
     ]

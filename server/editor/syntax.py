@@ -11,6 +11,7 @@ from __future__ import annotations
 import ast
 from dataclasses import dataclass
 
+from sandbox import python_ast
 from server.editor.diagnostics import Diagnostic, Severity
 
 SYNTAX_RULE = "E999"  # the code ruff used for syntax errors; editors and students know it
@@ -29,7 +30,7 @@ class Parsed:
 
 def parse(code: str) -> Parsed:
     try:
-        return Parsed(ast.parse(code), [], False)
+        return Parsed(python_ast.parse(code), [], False)
     except (RecursionError, MemoryError):
         return Parsed(None, [_whole_file(code, TOO_DEEP)], True)
     except SyntaxError as error:

@@ -26,6 +26,7 @@ from collections.abc import Mapping
 
 import msgspec
 
+from sandbox import python_ast
 from sandbox.launch2.job import ERROR_TYPE
 from sandbox.launch2.plan import PLAN_ARTIFACT, Plan, PlannedNode
 from sandbox.launcher import Launcher
@@ -48,7 +49,7 @@ def is_python_launch(path: str, text: str | bytes | None = None) -> bool:
     if isinstance(text, bytes):
         text = text.decode("utf-8", "replace")
     try:
-        tree = ast.parse(text)
+        tree = python_ast.parse(text)
     except (SyntaxError, ValueError):
         return False
     return any(

@@ -27,6 +27,8 @@ from typing import Any
 
 import yaml
 
+from sandbox import python_ast
+
 MAX_LAUNCH_BYTES = 256 * 1024  # [bytes] a launch file larger than this is not hand-written
 _SUBSTITUTION = re.compile(r"\$\(([^()]*)\)")
 _PARAM_TYPES = ("auto", "str", "string", "int", "double", "bool", "boolean", "yaml")
@@ -209,7 +211,7 @@ def _angle(text: str, prefix: str) -> float:
     if text.startswith(prefix + "(") and text.endswith(")"):
         text = text[len(prefix) + 1 : -1]
     try:
-        return _arithmetic(ast.parse(text, mode="eval"))
+        return _arithmetic(python_ast.parse(text, mode="eval"))
     except (SyntaxError, ValueError, ZeroDivisionError):
         raise yaml.YAMLError(
             f"invalid angle '{text}': use a number or arithmetic with pi, e.g. rad(pi/2)"

@@ -18,6 +18,7 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from sandbox import python_ast
 from sandbox.protocol import Api, Clock
 from server.runs.commands import SCRIPTABLE, RunCommand
 from server.sim import load_world, robot_ids, robots_for_world, world_ids
@@ -204,7 +205,7 @@ def _ros_version_of_code(code: str) -> tuple[int | None, str]:
     """What a file's imports say (rclpy wins over rospy: a file trying one then the other is
     written for ROS 2 first); a file that does not parse is left to its own error later."""
     try:
-        tree = ast.parse(code)
+        tree = python_ast.parse(code)
     except (SyntaxError, ValueError):
         return None, ""
     imported = set()

@@ -38,6 +38,7 @@ from typing import Any
 
 import numpy as np
 
+from sandbox import python_ast
 from sandbox.msgs import get_message_class
 from sandbox.protocol import Clock, Envelope, NodeInfo, RobotTopic, Shutdown, Wake, Yield
 from sandbox.ros_errors import ROSInterruptException
@@ -185,14 +186,14 @@ def _namespace(
         from sandbox.host import install_ros_compat  # `from std_msgs.msg import ...`
 
         install_ros_compat(1)
-        tree = ast.parse(controller, "<controller>")
+        tree = python_ast.parse(controller, "<controller>")
         module = types.ModuleType("step_controller")
         exec(compile(tree, "<controller>", "exec"), module.__dict__)
         namespace = module.__dict__
     elif isinstance(controller, types.ModuleType):
         namespace = dict(vars(controller))
         source = inspect.getsource(controller)
-        tree = ast.parse(source)
+        tree = python_ast.parse(source)
     elif callable(controller):
         namespace = {"step": controller}
         tree = ast.Module(body=[], type_ignores=[])
