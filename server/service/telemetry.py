@@ -284,10 +284,11 @@ class Viewer:
     # ----------------------------------------------------------------------------- subscriptions
     def subscribe(self, topic: str, max_rate_hz: float) -> None:
         """Send ``topic``'s newest sample at most ``max_rate_hz`` times a second. A topic with
-        no messages yet is fine (it may start later); subscribing again changes the rate."""
+        no messages yet is fine (it may start later); subscribing again changes the rate.
+        ``topic`` is read as a global ROS name: "/scan" is the bus's "scan" (`_bus_name`)."""
         if self._closed:
             raise SubscriptionError("this viewer is closed; open a new one to subscribe")
-        _check_topic(topic)
+        topic = _bus_name(topic)
         if isinstance(max_rate_hz, bool) or not isinstance(max_rate_hz, int | float):
             raise SubscriptionError(
                 f"max_rate_hz is a number of frames per second, got {max_rate_hz!r}"
@@ -314,7 +315,7 @@ class Viewer:
         self._event.set()
 
     def unsubscribe(self, topic: str) -> None:
-        if self._subscriptions.pop(topic, None) is None:
+        if self._subscriptions.pop(_bus_name(topic), None) is None:
             subscribed = ", ".join(sorted(self._subscriptions)) or "none"
             raise SubscriptionError(f"not subscribed to {topic!r}; subscribed topics: {subscribed}")
 
@@ -506,7 +507,14 @@ def latency_summary(latencies_s: Any) -> dict[str, float | int | None]:
     return {"count": len(ordered), "p50_s": rank(0.5), "p99_s": rank(0.99), "max_s": ordered[-1]}
 
 
-def _check_topic(topic: Any) -> None:
+def _bus_name(topic: Any) -> str:
+    """The run's bus name of a topic a viewer names, or SubscriptionError with a sentence.
+
+    The bus names root topics without the leading slash (sandbox/names.py): a viewer stands in
+    the root namespace, where rospy resolves "/scan" and "scan" to the same topic, and students
+    copy names from `rostopic list`, which prints "/scan". So "/scan" subscribes to "scan" and
+    its frames say "scan", as the snapshot's topics do; repeated and trailing slashes go, as
+    rosgraph's canonical form drops them ("//ultrasonic//range_0/" -> "ultrasonic/range_0")."""
     if not isinstance(topic, str) or not topic:
         raise SubscriptionError(f"a topic is a non-empty name such as 'scan', got {topic!r}")
     if len(topic) > MAX_TOPIC_CHARS or not topic.isprintable() or any(c.isspace() for c in topic):
@@ -514,3 +522,7 @@ def _check_topic(topic: Any) -> None:
             f"{topic[:40]!r}... is not a topic name: at most {MAX_TOPIC_CHARS} printable "
             "characters without spaces, such as 'scan' or '/ultrasonic/range_0'"
         )
+    name = "/".join(part for part in topic.split("/") if part)
+    if not name:
+        raise SubscriptionError(f"{topic!r} names no topic; name one such as 'scan'")
+    return name

@@ -244,6 +244,32 @@ def test_unsubscribed_and_unknown_topics() -> None:
     asyncio.run(main())
 
 
+def test_a_topic_named_as_rostopic_prints_it_is_the_bus_topic() -> None:
+    """`rostopic list` prints "/scan"; the bus names root topics "scan" (sandbox/names.py). A
+    viewer subscribing "/scan" used to be acked and then sent nothing."""
+
+    async def main() -> None:
+        telemetry = RunTelemetry("r6b")
+        telemetry.on_message("scan", INT32, 0, int32(7))
+        telemetry.on_message("ultrasonic/range_0", INT32, 0, int32(8))
+        viewer = telemetry.viewer()
+        viewer.subscribe("/scan", max_rate_hz=10)
+        viewer.subscribe("//ultrasonic//range_0/", max_rate_hz=10)
+        assert viewer.subscriptions == {"scan": 10, "ultrasonic/range_0": 10}
+        frames = await viewer.next_frames(timeout_s=1.0)
+        sent = {f["topic"]: f["msg"] for f in frames if f["type"] == "telemetry"}
+        assert sent == {"scan": {"data": 7}, "ultrasonic/range_0": {"data": 8}}
+        viewer.subscribe("scan", max_rate_hz=2)  # the same subscription, a new rate
+        assert viewer.subscriptions == {"scan": 2, "ultrasonic/range_0": 10}
+        viewer.unsubscribe("/scan")
+        assert viewer.subscriptions == {"ultrasonic/range_0": 10}
+        for nothing in ("/", "///"):
+            with pytest.raises(SubscriptionError, match="names no topic"):
+                viewer.subscribe(nothing, 10)
+
+    asyncio.run(main())
+
+
 def test_subscription_requests_are_checked() -> None:
     async def main() -> None:
         viewer = RunTelemetry("r7").viewer()

@@ -18,6 +18,8 @@ message per op, dispatched from a table: server/api/live_ops.py):
     {"op": "resume"} / {"op": "button", "pressed": true} / {"op": "light", "x", "y", "name"?}
     {"op": "goal", "x", "y", "yaw"?} / {"op": "teleop", "key": "up", "pressed": true}
 A stop's reason and an emergency stop's "who" come from the login, never from the frame.
+Topics are named as the snapshot names them, root topics without the leading slash; a name as
+`rostopic list` prints it ("/scan") is the same topic, and its frames say "scan".
 
 Latest wins: a slow client gets the newest sample at its rate and a count of what it missed;
 nothing queues per client beyond one frame in flight. Someone else's run: closed with code
