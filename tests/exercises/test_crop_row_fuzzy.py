@@ -66,6 +66,23 @@ def test_the_tabulated_curve_is_the_control_systems_output():
         assert ref.control_action(l_m) == pytest.approx(ref.fuzzy_output(l_m), abs=0.05)
 
 
+def test_the_curve_computed_in_stretches_is_bit_for_bit_the_whole_curve(monkeypatch):
+    """The reference computes u(l) where l falls, a stretch at a time; grading must not move."""
+    monkeypatch.setattr(ref, "_curve_u", None)
+    monkeypatch.setattr(ref, "_fuzzy", None)
+    visited = (0.4, 0.4137, 0.0199, 0.02, 0.7999, 0.8, -0.3, 1.2)
+    actions = [ref.control_action(l_m) for l_m in visited]
+    computed = ~np.isnan(ref._curve_u)
+    assert 0 < computed.sum() < ref._curve_u.size / 4  # only the stretches those l needed
+    fuzzy = ref.build_fuzzy()
+    fuzzy.input["l"] = ref._l_universe()
+    with ref._quiet_skfuzzy():
+        fuzzy.compute()
+    whole = np.asarray(fuzzy.output["u"], dtype=np.float64)
+    assert np.array_equal(ref._curve_u[computed], whole[computed])
+    assert actions == [float(np.interp(l_m, ref._l_universe(), whole)) for l_m in visited]
+
+
 def test_distances_beyond_the_universe_saturate():
     assert ref.control_action(-0.1) == ref.control_action(0.0)
     assert ref.control_action(1.5) == ref.control_action(0.8)

@@ -99,9 +99,17 @@ U_ZERO_HALF_WIDTH = 42.8
 U_TURN_RIGHT = (32.6, 54.8, 77.0)  # TR
 U_TURN_RIGHT_HARD = (61.3, 91.1, 97.3)  # TRR
 L_RANGE_M = (0.0, 0.8)  # [m] input universe
+TARGET_L_M = 0.4  # [m] the centre set C's peak: where a following rover's l stays
 U_RANGE = (-100.0, 100.0)  # [1] output universe
 
-_table: tuple[np.ndarray, np.ndarray] | None = None  # (l [m], u [1]) on the input universe
+# The curve u(l) is computed a stretch of CURVE_CHUNK_POINTS millimetres at a time, where l first
+# falls: a run visits a few centimetres around 0.4 m, and the whole curve costs ~0.9 s of every
+# node's start (skfuzzy's centroid is a Python loop over the 2001-point output universe, ~1.3 ms a
+# point), where the stretches a run needs cost ~25 ms each. skfuzzy computes every point on its
+# own, so a stretch's values are bit for bit those of the whole curve (tests compare them).
+CURVE_CHUNK_POINTS = 20  # [1] millimetre points computed together
+_fuzzy: ctrl.ControlSystemSimulation | None = None
+_curve_u = None  # u [1] at every millimetre of the input universe, NaN until computed
 
 
 def _l_universe() -> np.ndarray:
@@ -160,26 +168,42 @@ def fuzzy_output(l_m: float) -> float:
     return float(fuzzy.output["u"])
 
 
+def _computed_curve(first: int, last: int) -> np.ndarray:
+    """u at every millimetre, with at least points `first`..`last` of the universe computed."""
+    global _fuzzy, _curve_u
+    l_m = _l_universe()
+    if _curve_u is None:
+        _fuzzy = build_fuzzy()
+        _curve_u = np.full(l_m.size, np.nan)
+    for chunk in range(first // CURVE_CHUNK_POINTS, last // CURVE_CHUNK_POINTS + 1):
+        # Every stretch the same length (the last one ends at 0.8 m): skfuzzy warns when an
+        # input's shape changes between computes.
+        start = min(chunk * CURVE_CHUNK_POINTS, l_m.size - CURVE_CHUNK_POINTS)
+        points = slice(start, start + CURVE_CHUNK_POINTS)
+        if np.isnan(_curve_u[points]).any():
+            _fuzzy.input["l"] = l_m[points]
+            with _quiet_skfuzzy():
+                _fuzzy.compute()
+            _curve_u[points] = np.asarray(_fuzzy.output["u"], dtype=np.float64)
+    return _curve_u
+
+
 def control_table() -> tuple[np.ndarray, np.ndarray]:
-    """The controller's whole curve: u at every millimetre of l, computed once (~1 s).
+    """The controller's whole curve: u at every millimetre of l (~0.9 s the first time).
 
     A single compute() costs 4-15 ms, most of it skfuzzy's rule-graph bookkeeping (networkx); with
     one input the curve is all there is to know, so the loop interpolates it (error < 0.01)."""
-    global _table
-    if _table is None:
-        fuzzy = build_fuzzy()
-        l_m = _l_universe()
-        fuzzy.input["l"] = l_m
-        with _quiet_skfuzzy():
-            fuzzy.compute()
-        _table = (l_m, np.asarray(fuzzy.output["u"], dtype=np.float64))
-    return _table
+    return _l_universe(), _computed_curve(0, _l_universe().size - 1)
 
 
 def control_action(l_m: float) -> float:
     """The fuzzy control word u for a lateral distance `l_m` [m] to the left row (clipped to
-    0..0.8 m); positive turns right, away from the row."""
-    l_table, u_table = control_table()
+    0..0.8 m); positive turns right, away from the row. Interpolates the curve between the two
+    millimetres around l, computing their stretch of it the first time."""
+    l_table = _l_universe()
+    clipped_m = min(max(float(l_m), L_RANGE_M[0]), L_RANGE_M[1])
+    below = min(int(np.searchsorted(l_table, clipped_m, side="right")) - 1, l_table.size - 2)
+    u_table = _computed_curve(max(below, 0), below + 1)
     return float(np.interp(l_m, l_table, u_table))
 
 
@@ -298,8 +322,8 @@ _follower = RowFollower()
 
 
 def setup(info=None) -> None:
-    """Compute the fuzzy curve before the first step (it takes about a second)."""
-    control_table()
+    """Build the fuzzy controller and the curve around 0.4 m before the first step."""
+    control_action(TARGET_L_M)
 
 
 def reset() -> None:
