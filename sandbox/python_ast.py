@@ -19,7 +19,7 @@ import ast
 import threading
 from typing import Any, Literal
 
-# Held for the whole of a conversion between source, Python AST objects and the compiler's tree.
+# Held while source becomes Python AST objects (compiling a tree counts its depth per thread).
 ONE_PARSE_AT_A_TIME = threading.RLock()
 
 

@@ -35,6 +35,7 @@ from dataclasses import dataclass
 from itertools import islice
 from typing import Any
 
+from sandbox import names
 from sandbox.services import is_internal
 from server.runs.state import RunState
 from server.service.decode import decode
@@ -522,7 +523,7 @@ def _bus_name(topic: Any) -> str:
             f"{topic[:40]!r}... is not a topic name: at most {MAX_TOPIC_CHARS} printable "
             "characters without spaces, such as 'scan' or '/ultrasonic/range_0'"
         )
-    name = "/".join(part for part in topic.split("/") if part)
+    name = names.bus_name(names.canonicalize(topic))
     if not name:
         raise SubscriptionError(f"{topic!r} names no topic; name one such as 'scan'")
     return name

@@ -61,6 +61,7 @@ Design choices the paper leaves open (documented assumptions):
 from __future__ import annotations
 
 import contextlib
+import functools
 import math
 import warnings
 
@@ -112,6 +113,7 @@ _fuzzy: ctrl.ControlSystemSimulation | None = None
 _curve_u = None  # u [1] at every millimetre of the input universe, NaN until computed
 
 
+@functools.cache  # every step interpolates on it
 def _l_universe() -> np.ndarray:
     return np.round(np.arange(L_RANGE_M[0], L_RANGE_M[1] + 0.0005, 0.001), 3)  # [m] 1 mm
 
@@ -188,18 +190,13 @@ def _computed_curve(first: int, last: int) -> np.ndarray:
     return _curve_u
 
 
-def control_table() -> tuple[np.ndarray, np.ndarray]:
-    """The controller's whole curve: u at every millimetre of l (~0.9 s the first time).
-
-    A single compute() costs 4-15 ms, most of it skfuzzy's rule-graph bookkeeping (networkx); with
-    one input the curve is all there is to know, so the loop interpolates it (error < 0.01)."""
-    return _l_universe(), _computed_curve(0, _l_universe().size - 1)
-
-
 def control_action(l_m: float) -> float:
     """The fuzzy control word u for a lateral distance `l_m` [m] to the left row (clipped to
-    0..0.8 m); positive turns right, away from the row. Interpolates the curve between the two
-    millimetres around l, computing their stretch of it the first time."""
+    0..0.8 m); positive turns right, away from the row.
+
+    A single compute() costs 4-15 ms, most of it skfuzzy's rule-graph bookkeeping (networkx); with
+    one input the curve is all there is to know, so this interpolates it between the two
+    millimetres around l (error < 0.01), computing their stretch the first time."""
     l_table = _l_universe()
     clipped_m = min(max(float(l_m), L_RANGE_M[0]), L_RANGE_M[1])
     below = min(int(np.searchsorted(l_table, clipped_m, side="right")) - 1, l_table.size - 2)
