@@ -12,7 +12,9 @@ Prints
 With --workers N (issue 16) the realtime runs go through the lab's run service and executor
 instead, as `robodojo serve --workers N` runs them: N worker processes (one per core is the
 default), or 0 for the web process's own threads; it prints each rate's worst whole-run p99 and
-the worst p99 of each run's newest loop periods read live near its end (steady).
+the worst p99 of each run's newest loop periods read live near its end (steady), and, on
+worker processes, the CPU a run costs them and its sandbox per second of run (mid-run, no web
+process or viewer beside it): what sizing a worker core starts from.
 
 Usage: python bench/bench_runs.py [--repeats 5] [--concurrent 20] [--rates 20,50,100]
        python bench/bench_runs.py --workers 2 --rates 100     (and --workers 0 to compare)
@@ -23,6 +25,7 @@ p99 under 11 ms on this 2-core machine.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import statistics
 import tempfile
@@ -30,6 +33,7 @@ import threading
 import time
 from pathlib import Path
 
+import psutil
 from _common import percentile
 
 from sandbox.launcher import Launcher
@@ -188,7 +192,22 @@ def bench_executor(
     with store.session() as db:
         user_id = accounts.create_user(db, "bench", accounts.Role.STUDENT).user.id
     run_ids = [service.start(user_id, request).id for _ in range(count)]
-    time.sleep(duration_s * 0.9)
+    # CPU per run-second in the middle of the runs (start-up and end left out), the worker
+    # processes and their sandboxes apart: what a run costs a worker core, no web process or
+    # viewer beside it (bench_cluster.py measures those too).
+    # The window opens once the warm pools have refilled (a sandbox spawn is ~1 s of CPU, which
+    # is start-up, not running), at the latest halfway through the runs.
+    began = time.monotonic()
+    refilled = workers == 0
+    while not refilled and time.monotonic() - began < duration_s * 0.5:
+        refilled = service.executor.warm_count() >= workers * per_process
+        time.sleep(0.5)
+    time.sleep(max(0.0, duration_s * 0.2 - (time.monotonic() - began)))
+    processes = [psutil.Process(pid) for pid in service.executor.children_pids()] if workers else []
+    before, started = _cpu_s(processes), time.monotonic()
+    time.sleep(max(1.0, duration_s * 0.8 - (started - began)))
+    after, window_s = _cpu_s(processes), time.monotonic() - started
+    time.sleep(duration_s * 0.1)
     steady = []
     for run_id in run_ids:  # the newest loop periods, read live as the page reads them
         live = service.live(run_id)
@@ -218,7 +237,31 @@ def bench_executor(
         f"{statistics.median(whole) * 1e3 if whole else float('nan'):.2f} ms"
         f"{'  FAILED: ' + failed[0] if failed else ''}  -> {'ok' if ok else 'over'}"
     )
+    if workers:
+        per_run = {part: (after[part] - before[part]) / window_s / count for part in after}
+        print(
+            f"  CPU per run over {window_s:.0f} s mid-run: worker processes "
+            f"{per_run['worker'] * 1e3:.2f} ms per run-second ({per_run['worker'] * 100:.2f}% of "
+            f"a core), sandboxes {per_run['sandboxes'] * 1e3:.2f} ms per run-second"
+            f"{'' if refilled else ' (warm pools still refilling: their spawns are in it)'}"
+        )
     return ok, worst_steady, worst_whole
+
+
+def _cpu_s(processes: list[psutil.Process]) -> dict[str, float]:
+    """CPU seconds (user + system) so far of the worker processes and of their sandboxes (a
+    sandbox that ended meanwhile is left out of both snapshots' difference by the run's end)."""
+    totals = {"worker": 0.0, "sandboxes": 0.0}
+    for worker in processes:
+        with contextlib.suppress(psutil.Error):
+            times = worker.cpu_times()
+            totals["worker"] += times.user + times.system
+            totals["sandboxes"] += times.children_user + times.children_system
+            for child in worker.children(recursive=True):
+                with contextlib.suppress(psutil.Error):
+                    child_times = child.cpu_times()
+                    totals["sandboxes"] += child_times.user + child_times.system
+    return totals
 
 
 def main() -> None:
