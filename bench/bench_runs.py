@@ -34,7 +34,7 @@ import time
 from pathlib import Path
 
 import psutil
-from _common import percentile
+from _common import describe_machine, percentile
 
 from sandbox.launcher import Launcher
 from sandbox.protocol import Clock
@@ -195,17 +195,10 @@ def bench_executor(
     # CPU per run-second in the middle of the runs (start-up and end left out), the worker
     # processes and their sandboxes apart: what a run costs a worker core, no web process or
     # viewer beside it (bench_cluster.py measures those too).
-    # The window opens once the warm pools have refilled (a sandbox spawn is ~1 s of CPU, which
-    # is start-up, not running), at the latest halfway through the runs.
-    began = time.monotonic()
-    refilled = workers == 0
-    while not refilled and time.monotonic() - began < duration_s * 0.5:
-        refilled = service.executor.warm_count() >= workers * per_process
-        time.sleep(0.5)
-    time.sleep(max(0.0, duration_s * 0.2 - (time.monotonic() - began)))
+    time.sleep(duration_s * 0.3)
     processes = [psutil.Process(pid) for pid in service.executor.children_pids()] if workers else []
     before, started = _cpu_s(processes), time.monotonic()
-    time.sleep(max(1.0, duration_s * 0.8 - (started - began)))
+    time.sleep(duration_s * 0.5)
     after, window_s = _cpu_s(processes), time.monotonic() - started
     time.sleep(duration_s * 0.1)
     steady = []
@@ -238,30 +231,39 @@ def bench_executor(
         f"{'  FAILED: ' + failed[0] if failed else ''}  -> {'ok' if ok else 'over'}"
     )
     if workers:
-        per_run = {part: (after[part] - before[part]) / window_s / count for part in after}
+        used = _cpu_used_s(before, after)
+        per_run = {part: seconds / window_s / count for part, seconds in used.items()}
         print(
             f"  CPU per run over {window_s:.0f} s mid-run: worker processes "
             f"{per_run['worker'] * 1e3:.2f} ms per run-second ({per_run['worker'] * 100:.2f}% of "
             f"a core), sandboxes {per_run['sandboxes'] * 1e3:.2f} ms per run-second"
-            f"{'' if refilled else ' (warm pools still refilling: their spawns are in it)'}"
         )
     return ok, worst_steady, worst_whole
 
 
-def _cpu_s(processes: list[psutil.Process]) -> dict[str, float]:
-    """CPU seconds (user + system) so far of the worker processes and of their sandboxes (a
-    sandbox that ended meanwhile is left out of both snapshots' difference by the run's end)."""
-    totals = {"worker": 0.0, "sandboxes": 0.0}
+def _cpu_s(processes: list[psutil.Process]) -> dict[str, float | dict[int, float]]:
+    """CPU seconds (user + system) so far of the worker processes, and of each of their
+    descendants (the sandboxes) by pid."""
+    worker_s, sandboxes = 0.0, {}
     for worker in processes:
         with contextlib.suppress(psutil.Error):
             times = worker.cpu_times()
-            totals["worker"] += times.user + times.system
-            totals["sandboxes"] += times.children_user + times.children_system
+            worker_s += times.user + times.system
             for child in worker.children(recursive=True):
                 with contextlib.suppress(psutil.Error):
                     child_times = child.cpu_times()
-                    totals["sandboxes"] += child_times.user + child_times.system
-    return totals
+                    sandboxes[child.pid] = child_times.user + child_times.system
+    return {"worker": worker_s, "sandboxes": sandboxes}
+
+
+def _cpu_used_s(before: dict, after: dict) -> dict[str, float]:
+    """CPU seconds between two `_cpu_s` snapshots. A sandbox counts only if it was there at both:
+    one spawned in between (a warm pool's refill, ~1 s of imports) is start-up, not running."""
+    kept = after["sandboxes"].keys() & before["sandboxes"].keys()
+    return {
+        "worker": after["worker"] - before["worker"],
+        "sandboxes": sum(after["sandboxes"][pid] - before["sandboxes"][pid] for pid in kept),
+    }
 
 
 def main() -> None:
@@ -277,6 +279,7 @@ def main() -> None:
         help="realtime runs through the run service on N worker processes (0: in its threads)",
     )
     args = parser.parse_args()
+    print(describe_machine())  # figures of different hours compare only at a similar speed
     with tempfile.TemporaryDirectory(prefix="robodojo-bench-") as tmp:
         out = Path(tmp)
         if args.workers is not None:
