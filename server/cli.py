@@ -361,11 +361,17 @@ def build_parser() -> argparse.ArgumentParser:
     from server.workers.cli import add_command as add_worker_command
 
     add_worker_command(commands)
+    for command_parser in commands.choices.values():
+        command_parser.set_defaults(command_parser=command_parser)
     return parser
 
 
 def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
+    args, unknown = build_parser().parse_known_args(argv)
+    if unknown:
+        # The command's own usage and sentence (`robodojo serve: error: unrecognized arguments:
+        # --prot 8765`), not the top level's, which names no option the user could mean.
+        args.command_parser.error(f"unrecognized arguments: {' '.join(unknown)}")
     try:
         return args.func(args)
     except (RunSpecError, WorldError, SandboxUnavailable, StoreError, ValueError) as error:

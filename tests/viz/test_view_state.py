@@ -61,7 +61,10 @@ def test_plan_goal_and_a_published_lookahead():
     state = ViewState()
     path = Path(poses=[PoseStamped(pose=Pose(position=Point(x=i * 0.1, y=1.0))) for i in range(5)])
     state.apply("plan", path._type, 1.0, decode(path._type, path.serialize()))
-    assert state.plan == pytest.approx([(i * 0.1, 1.0) for i in range(5)])
+    # Point by point: pytest 9.2's approx() refuses nested sequences (a list of tuples).
+    assert len(state.plan) == 5
+    for point, expected in zip(state.plan, [(i * 0.1, 1.0) for i in range(5)], strict=True):
+        assert point == pytest.approx(expected)
     turned = Quaternion(z=1.0, w=0.0)  # half a turn
     goal = PoseStamped(pose=Pose(position=Point(x=3.0, y=4.0), orientation=turned))
     state.apply("goal_pose", goal._type, 1.0, decode(goal._type, goal.serialize()))
