@@ -43,8 +43,10 @@ def wheel_names(tmp_path_factory: pytest.TempPathFactory) -> set[str]:
     for name in tracked():
         (source / name).parent.mkdir(parents=True, exist_ok=True)
         shutil.copy2(ROOT / name, source / name, follow_symlinks=False)
+    # Built by this environment's setuptools (the lock's), not one an isolated build fetches.
     subprocess.run(
-        [sys.executable, "-m", "pip", "wheel", "--no-deps", "-q", "-w", str(scratch / "out"), "."],
+        [sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation", "-q",
+         "-w", str(scratch / "out"), "."],
         cwd=source, capture_output=True, check=True,
     )  # fmt: skip
     (wheel,) = (scratch / "out").glob("robodojo-*.whl")
