@@ -151,8 +151,10 @@ def parse_param_value(text: str) -> Any:
     `true` bool, `[1, 2]` list, anything else a string)."""
     import yaml  # lazy: only nodes given `_param:=value` arguments pay for the import
 
+    from sandbox import bounded_yaml
+
     try:
-        return yaml.safe_load(text)
+        return bounded_yaml.load(text)
     except yaml.YAMLError as error:
         raise InvalidName(f"cannot read the value '{text}' as YAML: {error}") from None
 

@@ -45,8 +45,10 @@ def parse_value(text: str) -> Any:
     """A parameter value as rcl types it (YAML)."""
     import yaml  # lazy: only nodes given parameters on their command line pay for it
 
+    from sandbox import bounded_yaml
+
     try:
-        return yaml.safe_load(text)
+        return bounded_yaml.load(text)
     except yaml.YAMLError as error:
         raise RosArgumentError(f"cannot read the value '{text}' as YAML: {error}") from None
 
@@ -106,13 +108,15 @@ def load_params_file(path: str) -> list[tuple[str, dict[str, Any]]]:
     """A ROS 2 parameters file: `node: {ros__parameters: {...}}` per node pattern."""
     import yaml
 
+    from sandbox import bounded_yaml
+
     if not os.path.exists(path):
         raise RosArgumentError(
             f"--params-file {path}: no such file in the workspace (paths are relative to it)"
         )
     try:
         with open(path, encoding="utf-8") as stream:
-            document = yaml.safe_load(stream)
+            document = bounded_yaml.load(stream.read())
     except yaml.YAMLError as error:
         raise RosArgumentError(f"--params-file {path}: not valid YAML: {error}") from None
     if not isinstance(document, Mapping):

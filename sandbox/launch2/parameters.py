@@ -27,6 +27,7 @@ from typing import Any
 
 import yaml
 
+from sandbox import bounded_yaml
 from sandbox.launch2.context import LaunchContext
 from sandbox.launch2.errors import LaunchError, Site, caller_site
 from sandbox.launch2.substitutions import Substitution, normalize, perform
@@ -132,7 +133,7 @@ def _evaluate_value(context: LaunchContext, value: Any, name: str, site: Site | 
 
 def _yaml_scalar(text: str, name: str, site: Site | None) -> Any:
     try:
-        value = yaml.safe_load(text) if text else ""
+        value = bounded_yaml.load(text) if text else ""
     except yaml.YAMLError:
         raise LaunchError(
             f"parameter '{name}': '{text}' cannot be read as a value; wrap it in "
@@ -193,7 +194,7 @@ def read_param_file(
 
 def parse_param_file(text: str, relative: str, site: Site | None) -> list[Rule]:
     try:
-        data = yaml.safe_load(text)
+        data = bounded_yaml.load(text)
     except yaml.YAMLError as error:
         mark = getattr(error, "problem_mark", None)
         where = f", line {mark.line + 1}" if mark is not None else ""

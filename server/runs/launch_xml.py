@@ -27,7 +27,7 @@ from typing import Any
 
 import yaml
 
-from sandbox import python_ast
+from sandbox import bounded_yaml, python_ast
 
 MAX_LAUNCH_BYTES = 256 * 1024  # [bytes] a launch file larger than this is not hand-written
 _SUBSTITUTION = re.compile(r"\$\(([^()]*)\)")
@@ -233,8 +233,9 @@ RosparamLoader.add_implicit_resolver("!radians", re.compile(r"^rad\([^\)]*\)$"),
 
 
 def load_yaml(text: str) -> Any:
-    """YAML as rosparam reads it; yaml.YAMLError on bad input."""
-    return yaml.load(text, Loader=RosparamLoader)  # a SafeLoader subclass: no Python objects
+    """YAML as rosparam reads it, its aliases bounded (sandbox/bounded_yaml.py: this runs in the
+    run worker, outside any sandbox); yaml.YAMLError on bad input."""
+    return bounded_yaml.load(text, RosparamLoader)  # a SafeLoader subclass: no Python objects
 
 
 def convert_value(value: str, kind: str) -> Any:
