@@ -45,6 +45,11 @@ class Settings(BaseSettings):
     max_files_per_workspace: int = Field(32, ge=1)  # a package: nodes, launch, config, data
     max_data_bytes_per_file: int = Field(1024 * KIB, ge=1)  # [B] a long CSV log, a big YAML map
     max_workspace_bytes: int = Field(4096 * KIB, ge=1)  # [B] newest versions; every run copies it
+    # Version history (older versions pruned, oldest first, at each save; a file's newest is
+    # always kept): hours of autosaves of a node, and twice the workspace, so a data file can be
+    # replaced a few times before its old versions go. Counted in the student's disk budget.
+    max_versions_per_file: int = Field(200, ge=1)  # every version the page lists
+    max_history_bytes_per_workspace: int = Field(8192 * KIB, ge=1)  # [B] all versions, all files
     max_request_body_bytes: int = Field(4096 * KIB, ge=1)  # [B] above every code limit; counted
     # as it arrives (chunked too), for every route, before login
     # Disk: a run leaves its recording, logs and artifacts (up to ~24 MiB of artifacts); runs

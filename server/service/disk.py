@@ -19,6 +19,7 @@ from pathlib import Path
 from sqlalchemy import func, select
 from sqlalchemy.orm import Session as Db
 
+from server.store import workspaces
 from server.store.models import LabSetting, RunRecord, User
 
 log = logging.getLogger("robodojo.disk")
@@ -65,23 +66,26 @@ def used_by(db: Db, user_id: str | None = None) -> int:
 
 
 def check_budgets(db: Db, user_id: str, settings) -> None:
-    """Raises DiskBudgetError when the student's or the lab's runs fill their budget."""
+    """Raises DiskBudgetError when the student's or the lab's runs, with their saved code's
+    version history (store/workspaces.py caps it per workspace), fill their budget."""
     mine_budget = settings.student_disk_budget_bytes
     if mine_budget:
-        mine = used_by(db, user_id)
-        if mine >= mine_budget:
+        runs, history = used_by(db, user_id), workspaces.history_bytes(db, user_id)
+        if runs + history >= mine_budget:
             raise DiskBudgetError(
-                f"your runs use {_mib(mine)} of disk; your budget is {_mib(mine_budget)}. "
+                f"your runs use {_mib(runs)} of disk and your saved code's history "
+                f"{_mib(history)}; your budget is {_mib(mine_budget)}. "
                 "No new run can start until space is freed: ask your instructor for a larger "
                 "budget, or for old runs' files to be removed (retention)"
             )
     lab_budget = settings.lab_disk_budget_bytes
     if lab_budget:
-        lab = used_by(db)
+        lab = used_by(db) + workspaces.history_bytes(db)
         if lab >= lab_budget:
             raise DiskBudgetError(
-                f"the lab's runs use {_mib(lab)} of disk; the lab's budget is {_mib(lab_budget)}. "
-                "No new runs can start until space is freed: ask your instructor"
+                f"the lab's runs and saved code use {_mib(lab)} of disk; the lab's budget is "
+                f"{_mib(lab_budget)}. No new runs can start until space is freed: ask your "
+                "instructor"
             )
 
 
@@ -174,6 +178,7 @@ def disk_status(db: Db, settings) -> dict:
     )
     return {
         "runs_bytes": used_by(db),
+        "history_bytes": workspaces.history_bytes(db),
         "lab_budget_bytes": settings.lab_disk_budget_bytes,
         "student_budget_bytes": settings.student_disk_budget_bytes,
         "retention_days": retention_days(db, settings),

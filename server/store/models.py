@@ -115,6 +115,8 @@ class CodeVersion(Base):
     version: Mapped[int] = mapped_column(Integer)
     code: Mapped[str] = mapped_column(Text)
     created_at: Mapped[float] = mapped_column(Float)
+    # [B] the code's UTF-8 size: history caps and disk budgets add these up (store/workspaces.py).
+    size_bytes: Mapped[int] = mapped_column(Integer, server_default="0")
 
 
 class RunRecord(Base):

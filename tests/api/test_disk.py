@@ -78,7 +78,7 @@ def test_a_student_over_budget_and_a_lab_over_budget_get_a_sentence_and_no_run(d
     refused = bob.post("/api/runs", json=short_run())
     assert refused.status_code == 507, refused.text
     detail = refused.json()["detail"]
-    assert "the lab's runs use" in detail and "ask your instructor" in detail
+    assert "the lab's runs and saved code use" in detail and "ask your instructor" in detail
     assert _runs_of(disk_lab, bob.user["id"]) == []
 
 
@@ -92,6 +92,21 @@ def test_the_status_shows_the_bytes_runs_use_and_the_top_students(disk_lab):
     assert use["student_budget_bytes"] == STUDENT_BUDGET
     top = use["top_students"][0]
     assert top["name"] == "ada" and top["bytes"] == on_disk
+
+
+def test_saved_codes_history_counts_in_the_students_budget(disk_lab):
+    """Issue 33, finding 9: versions are disk too; a student with no run but saved code is over
+    a one-byte budget on their own account, and the status adds the history up."""
+    dora = disk_lab.student("dora")
+    url = "/api/workspaces/crowbot/files/notes.txt"
+    saved = dora.put(url, json={"code": "x" * 100})
+    assert saved.status_code == 200, saved.text
+    refused = dora.post("/api/runs", json=short_run())
+    assert refused.status_code == 507, refused.text
+    assert "your runs use 0.0 MiB of disk and your saved code's history" in refused.json()["detail"]
+    assert disk_lab.admin().get("/api/admin/status").json()["disk"]["history_bytes"] == 100
+    assert dora.delete(url).status_code == 200  # her history goes with the file
+    assert disk_lab.admin().get("/api/admin/status").json()["disk"]["history_bytes"] == 0
 
 
 def test_retention_removes_old_runs_files_and_keeps_their_metrics(disk_lab):

@@ -54,3 +54,22 @@ def test_a_workspace_must_name_an_exercise_or_a_robot(lab):
         for i in range(33)
     ]
     assert too_many[:32] == [200] * 32 and too_many[32] == 422
+
+
+def test_history_is_pruned_oldest_first_and_the_listing_says_so(lab):
+    """Issue 33, finding 9: saves of a large data file keep the newest 8 MiB of history (the
+    default cap), not every version; the listing says which versions were pruned."""
+    student = lab.student("big-saver")
+    url = "/api/workspaces/crowbot/files/map.csv"
+    for n in range(12):
+        body = f"{n:02d}," + "1" * 1_000_000
+        assert student.put(url, json={"code": body}).status_code == 200
+    listing = student.get(f"{url}/versions").json()
+    numbers = [v["version"] for v in listing["versions"]]
+    assert numbers == list(range(12, 12 - len(numbers), -1))  # the newest, none skipped
+    assert (
+        sum(v["bytes"] for v in listing["versions"]) <= 8 * 1024 * 1024 < len(numbers) * 1e6 + 1e6
+    )
+    assert listing["pruned"] and listing["oldest_kept"] == numbers[-1] > 1
+    assert listing["kept"] == {"versions_per_file": 200, "workspace_bytes": 8 * 1024 * 1024}
+    assert student.get(f"{url}/versions/1").status_code == 404  # pruned

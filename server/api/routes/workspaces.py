@@ -46,6 +46,13 @@ def _filename(name: str) -> str:
     return workspace_files.file_name(name)  # WorkspaceFileError: a 4xx with its sentence
 
 
+def history_caps(settings) -> store.HistoryCaps:
+    return store.HistoryCaps(
+        versions_per_file=settings.max_versions_per_file,
+        workspace_bytes=settings.max_history_bytes_per_workspace,
+    )
+
+
 def caps(settings) -> workspace_files.Caps:
     return workspace_files.Caps(
         code_bytes=settings.max_code_bytes_per_file,
@@ -110,7 +117,8 @@ def save_file(
             v.filename: len(v.code.encode()) for v in store.latest_files(db, caller.id, workspace)
         }
         workspace_files.check_fits(name, body.code, sizes, limits)
-        return _version_out(store.save(db, caller.id, workspace, name, body.code), False)
+        history = history_caps(request.app.state.settings)
+        return _version_out(store.save(db, caller.id, workspace, name, body.code, history), False)
 
 
 @router.get("/{workspace}/files/{filename:path}/versions", summary="A file's saved versions")
@@ -120,11 +128,23 @@ def list_versions(
     filename: str = FileName,
     caller: Caller = Depends(current_user),
 ) -> dict:
+    name = _filename(filename)
     with request.app.state.store.session() as db:
-        found = store.versions(db, caller.id, workspace, _filename(filename))
+        found = store.versions(db, caller.id, workspace, name)
+        oldest = store.oldest_kept(db, caller.id, workspace, name)
     if not found:
         raise HTTPException(404, f"no saved versions of '{filename}' in '{workspace}'")
-    return {"versions": [_version_out(v, False) for v in found]}
+    history = history_caps(request.app.state.settings)
+    return {
+        "versions": [_version_out(v, False) for v in found],
+        # What the page says under the list: versions before `oldest_kept` were pruned.
+        "oldest_kept": oldest,
+        "pruned": oldest > 1,
+        "kept": {
+            "versions_per_file": history.versions_per_file,
+            "workspace_bytes": history.workspace_bytes,
+        },
+    }
 
 
 def _one_version(request: Request, caller: Caller, workspace: str, filename: str, number: int):
@@ -158,5 +178,6 @@ def restore_version(
     caller: Caller = Depends(current_user),
 ) -> dict:
     old = _one_version(request, caller, workspace, filename, number)
+    history = history_caps(request.app.state.settings)
     with request.app.state.store.session() as db:
-        return _version_out(store.save(db, caller.id, workspace, old.filename, old.code))
+        return _version_out(store.save(db, caller.id, workspace, old.filename, old.code, history))

@@ -50,8 +50,10 @@ async function open() {
   preview.setState(previewState(""));
   dialog.showModal();
   let versions = [];
+  let listing = null;
   try {
-    versions = (await api(`${base(file)}/versions`)).versions;
+    listing = await api(`${base(file)}/versions`);
+    versions = listing.versions;
   } catch (error) {
     if (error.status !== 404) {
       parts.message.textContent = error.message;
@@ -60,7 +62,7 @@ async function open() {
   }
   const starter = starterOf(file.filename);
   parts.message.textContent = versions.length
-    ? "Every save is a version. View one, or restore it as the newest."
+    ? "Every save is a version. View one, or restore it as the newest." + pruned(listing)
     : "No saved versions yet: edits are saved a moment after you stop typing.";
   const newestFirst = [...versions].sort((a, b) => b.version - a.version);
   fill(
@@ -87,6 +89,16 @@ async function open() {
       : null,
   );
   if (newestFirst.length) view(file, newestFirst[0].version);
+}
+
+// What the history keeps (server/store/workspaces.py), said when older versions were removed.
+function pruned(listing) {
+  if (!listing?.pruned) return "";
+  const kept = listing.kept;
+  return (
+    ` Versions before v${listing.oldest_kept} were removed: a file keeps its newest ` +
+    `${kept.versions_per_file} versions, and this workspace the newest ${bytes(kept.workspace_bytes)} of history.`
+  );
 }
 
 function base(file) {
