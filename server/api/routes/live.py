@@ -41,7 +41,7 @@ from starlette.concurrency import run_in_threadpool
 
 from server.api.auth import foreign_origin, websocket_user
 from server.api.live_ops import LiveContext, apply_live
-from server.api.sockets import REVOKED_CODE, REVOKED_REASON
+from server.api.sockets import still_valid
 from server.runs.commands import CommandError
 from server.service.telemetry import (
     KEEP_AFTER_END_S,
@@ -117,6 +117,12 @@ async def live(websocket: WebSocket, run_id: str) -> None:
     context = LiveContext(caller, run_id, service, viewer)
     send_lock = asyncio.Lock()
 
+    def recheck() -> bool:
+        """The handshake's credential still names this caller (not logged out, renewed,
+        expired or disabled since)."""
+        again = websocket_user(websocket)
+        return again is not None and again.id == caller.id
+
     async def send(frame: dict) -> None:
         async with send_lock:
             await websocket.send_text(json.dumps(frame, allow_nan=False, default=str))
@@ -145,6 +151,8 @@ async def live(websocket: WebSocket, run_id: str) -> None:
                 if not isinstance(request_id, str | int | None) or isinstance(request_id, bool):
                     request_id = None
                     raise CommandError("'id' must be a string or an integer")
+                if not await still_valid(recheck, revoked):
+                    return  # the credential ended: nothing more is done for this socket
                 await apply_live(command, context)
             except (CommandError, SubscriptionError, ValueError, TypeError) as error:
                 await send({"type": "error", "id": request_id, "detail": str(error)})
@@ -160,15 +168,15 @@ async def live(websocket: WebSocket, run_id: str) -> None:
         await send({"type": "end", "state": final["state"], "reason": final["reason"]})
 
     close_code, close_reason = 1000, ""
-    async with app.state.sockets.held(caller.id) as revoked:
-        if await run_in_threadpool(websocket_user, websocket) is None:
-            revoked.set()  # disabled between the handshake's check and this registration
-        tasks = [asyncio.create_task(reader()), asyncio.create_task(writer())]
+    async with app.state.sockets.held(caller.id, recheck) as revoked:
+        # Ended between the handshake's check and this registration: nothing is sent.
+        valid = await still_valid(recheck, revoked)
+        tasks = [asyncio.create_task(reader()), asyncio.create_task(writer())] if valid else []
         disabled = asyncio.create_task(revoked.wait())
         try:
             done, _ = await asyncio.wait([*tasks, disabled], return_when=asyncio.FIRST_COMPLETED)
-            if disabled in done:
-                close_code, close_reason = REVOKED_CODE, REVOKED_REASON
+            if revoked.is_set():
+                close_code, close_reason = revoked.code, revoked.reason
             for task in done - {disabled}:
                 error = task.exception()
                 if error is not None and not isinstance(error, WebSocketDisconnect | RuntimeError):

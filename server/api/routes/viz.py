@@ -33,7 +33,7 @@ from websockets.exceptions import ConnectionClosed, InvalidHandshake
 
 from server.api.auth import Caller, current_user, foreign_origin, websocket_user
 from server.api.routes.runs import NOT_FOUND, file_answer, files_of, visible_run
-from server.api.sockets import REVOKED_CODE, REVOKED_REASON
+from server.api.sockets import Revoked, still_valid
 from server.store import runs as run_store
 from server.viz.manager import LOOPBACK, VizManager
 
@@ -160,15 +160,24 @@ async def view_socket(websocket: WebSocket, run_id: str) -> None:
             return
         async with upstream:
             await websocket.accept(subprotocol=upstream.subprotocol)
-            async with websocket.app.state.sockets.held(caller.id) as revoked:
-                if await run_in_threadpool(websocket_user, websocket) is None:
-                    revoked.set()  # disabled between the handshake's check and now
-                await _pump(websocket, upstream, revoked)
+
+            def recheck() -> bool:
+                """The handshake's credential still names this caller."""
+                again = websocket_user(websocket)
+                return again is not None and again.id == caller.id
+
+            async with websocket.app.state.sockets.held(caller.id, recheck) as revoked:
+                if await still_valid(recheck, revoked):
+                    await _pump(websocket, upstream, revoked)
+                else:  # ended between the handshake and now: nothing is forwarded
+                    with contextlib.suppress(Exception):
+                        await websocket.close(code=revoked.code, reason=revoked.reason)
 
 
-async def _pump(websocket: WebSocket, upstream, revoked: asyncio.Event) -> None:
+async def _pump(websocket: WebSocket, upstream, revoked: Revoked) -> None:
     """Forward both ways until either side closes; then close the other with the same code.
-    `revoked` set (the user was disabled): both close, the browser with 1008."""
+    `revoked` set (the user was disabled, or the credential ended): both close, the browser
+    with revoked's code and reason."""
 
     async def browser_to_viser() -> tuple[int, str]:
         while True:
@@ -200,7 +209,7 @@ async def _pump(websocket: WebSocket, upstream, revoked: asyncio.Event) -> None:
                 await task
     code, reason = 1000, ""
     if revoked.is_set():
-        code, reason = REVOKED_CODE, REVOKED_REASON
+        code, reason = revoked.code, revoked.reason
     elif to_browser.done() and not to_browser.cancelled() and to_browser.exception() is None:
         code, reason = to_browser.result()  # viser closed: the browser hears why
     with contextlib.suppress(Exception):
