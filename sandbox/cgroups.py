@@ -6,7 +6,11 @@ the order `detect()` tries them, with `describe()` naming the one in force:
 
 - `ROBODOJO_CGROUP_ROOT` set: cgroup v2 under that writable, delegated directory.
 - cgroup v1 `memory` and `pids` hierarchies mounted and writable (as root on the lab machines):
-  each node gets `<our own cgroup>/robodojo/<name>` in both hierarchies (no CPU cap on v1).
+  each node gets `<our own cgroup>/robodojo/<name>` in both hierarchies, and in the `cpu`
+  hierarchy too when it is mounted and writable: cpu.cfs_period_us and cpu.cfs_quota_us are the
+  v1 spelling of v2's cpu.max (Documentation/scheduler/sched-bwc.rst), one core by default. A v1
+  host without a usable `cpu` hierarchy caps a node's CPU by RLIMIT_CPU (its whole life) and its
+  threads by pids.max only (issue 33, finding 10: 8 spinning threads took both cores).
 - cgroup v2: the cgroup2 mount is found in /proc/self/mountinfo and our own cgroup in
   /proc/self/cgroup (`0::/path`). If that cgroup is delegated to us (systemd `Delegate=yes`, or
   writable) and offers `memory` and `pids`, we obey the "no internal processes" rule of
@@ -105,50 +109,65 @@ class NodeCgroupV2(NodeCgroup):
 
 
 class Cgroups:
-    """Creates per-node groups under `<own>/robodojo` in the v1 memory and pids hierarchies."""
+    """Creates per-node groups under `<own>/robodojo` in the v1 memory and pids hierarchies,
+    and the cpu hierarchy when there is one."""
 
     def __init__(self, bases: dict[str, str]) -> None:
         self.bases = bases  # controller -> directory of our "robodojo" group
 
     @classmethod
-    def detect(cls) -> Cgroups | None:
+    def detect(cls, root: str = V1_ROOT) -> Cgroups | None:
         bases = {}
-        for controller in ("memory", "pids"):
-            own = _own_path(controller)
-            mount = os.path.join(V1_ROOT, controller)
-            if own is None or not os.path.isdir(mount):
+        for controller in ("memory", "pids", "cpu"):
+            base = _v1_base(root, controller)
+            if base is None and controller != "cpu":  # cpu is a bonus; the others are needed
                 return None
-            base = os.path.join(mount, own.lstrip("/"), "robodojo")
-            try:
-                os.makedirs(base, exist_ok=True)
-            except OSError:
-                return None
-            if not os.access(base, os.W_OK):
-                return None
-            bases[controller] = base
+            if base is not None:
+                bases[controller] = base
         return cls(bases)
 
     def describe(self) -> str:
-        return "cgroup v1 (memory and pids hierarchies: " + ", ".join(self.bases.values()) + ")"
+        names = " and ".join(self.bases)
+        cpu = "" if "cpu" in self.bases else "; no cpu hierarchy: CPU capped by RLIMIT_CPU only"
+        return f"cgroup v1 ({names} hierarchies: " + ", ".join(self.bases.values()) + f"){cpu}"
 
     def create(self, limits: Limits) -> NodeCgroup:
         memory_bytes, max_pids = limits.memory_bytes, limits.max_pids
         name = f"node-{os.getpid()}-{next(_counter)}"
-        memory = os.path.join(self.bases["memory"], name)
-        pids = os.path.join(self.bases["pids"], name)
-        os.makedirs(memory, exist_ok=True)
-        os.makedirs(pids, exist_ok=True)
-        group = NodeCgroup([memory, pids])
+        # Memory first: oom_killed() reads directories[0].
+        directories = [os.path.join(base, name) for base in self.bases.values()]
+        for directory in directories:
+            os.makedirs(directory, exist_ok=True)
+        group = NodeCgroup(directories)
+        memory, pids = (os.path.join(self.bases[c], name) for c in ("memory", "pids"))
         try:
             _write(os.path.join(memory, "memory.limit_in_bytes"), memory_bytes)
             # Same cap on memory + swap where swap accounting exists: no escape into swap.
             with contextlib.suppress(OSError):
                 _write(os.path.join(memory, "memory.memsw.limit_in_bytes"), memory_bytes)
             _write(os.path.join(pids, "pids.max"), max_pids)
+            if "cpu" in self.bases:
+                cpu = os.path.join(self.bases["cpu"], name)
+                _write(os.path.join(cpu, "cpu.cfs_period_us"), limits.cpu_period_us)
+                _write(os.path.join(cpu, "cpu.cfs_quota_us"), limits.cpu_quota_us)
         except OSError:
             group.remove()
             raise
         return group
+
+
+def _v1_base(root: str, controller: str) -> str | None:
+    """Our writable `robodojo` group in the v1 hierarchy of `controller`, made if missing."""
+    own = _own_path(controller)
+    mount = os.path.join(root, controller)
+    if own is None or not os.path.isdir(mount):
+        return None
+    base = os.path.join(mount, own.lstrip("/"), "robodojo")
+    try:
+        os.makedirs(base, exist_ok=True)
+    except OSError:
+        return None
+    return base if os.access(base, os.W_OK) else None
 
 
 def _write(path: str, value: int | str) -> None:

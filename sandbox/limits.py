@@ -23,8 +23,11 @@ class Limits:
     memory_bytes: int = 768 * MiB
     # Threads and processes together (pids cgroup): the interpreter and BLAS need a handful.
     max_pids: int = 32
-    # CPU bandwidth (cgroup v2 cpu.max, "quota period" in microseconds): one core's worth, so a
-    # spinning node cannot take both cores of a 2-core lab machine from the server and the others.
+    # CPU bandwidth ("quota period" in microseconds: cgroup v2 cpu.max, or cgroup v1's
+    # cpu.cfs_quota_us and cpu.cfs_period_us): one core's worth, so a spinning node, however
+    # many threads it starts, cannot take both cores of a 2-core lab machine from the server
+    # and the others. A host with neither controller has only cpu_seconds below and max_pids
+    # (sandbox/cgroups.py says which one is in force; the server logs it at start).
     cpu_quota_us: int = 100_000
     cpu_period_us: int = 100_000
     # Scheduling niceness of a node process (the lab's own processes run at 0). When the machine

@@ -14,6 +14,7 @@ import time
 
 import pytest
 
+from sandbox import cgroups
 from sandbox.limits import DEFAULT_LIMITS
 from sandbox.protocol import Exited, Outcome, Yield
 from tests.sandbox.conftest import crowbot_info, run_script
@@ -368,3 +369,81 @@ def test_touched_memory_is_capped_by_the_cgroup_or_the_rlimit(launcher):
         assert "ran out of memory (its cap is 768 MiB)" in exited.reason
     else:
         assert exited.outcome is Outcome.ERROR and exited.error.type == "MemoryError"
+
+
+def test_spinning_threads_get_one_core_at_most(launcher):
+    """Issue 33, finding 10: on cgroup v1 a node with 8 spinning threads took both cores. With
+    the v1 cpu controller (or v2's cpu.max) it gets `cpu_quota_us / cpu_period_us` cores: its
+    CPU time over a wall-clock window stays within that, and the kernel says it throttled it."""
+    window_s = 1.5
+    # The kernel's own clock: time.monotonic() in a node is the run's clock (sandbox.vclock),
+    # which does not move while the node loads.
+    code = (
+        "import threading, time\n"
+        "def now():\n"
+        "    return time.clock_gettime(time.CLOCK_MONOTONIC)\n"
+        f"end = now() + {window_s}\n"
+        "def spin():\n"
+        "    while now() < end:\n"
+        "        pass\n"
+        "started_wall, started_cpu = now(), time.process_time()\n"
+        "threads = [threading.Thread(target=spin) for _ in range(8)]\n"
+        "for t in threads: t.start()\n"
+        "for t in threads: t.join()\n"
+        "wall, cpu = now() - started_wall, time.process_time() - started_cpu\n"
+        "raise RuntimeError(f'wall={wall:.3f} cpu={cpu:.3f}')\n"
+    )
+    # Whether this machine offers a CPU controller, not whether our detection found it: on a
+    # machine that has one, a launcher that does not use it fails here.
+    v1_cpu = os.path.join(cgroups.V1_ROOT, "cpu")
+    v2_cpu = "cpu" in getattr(launcher.cgroups, "controllers", [])
+    if launcher.cgroups is None or not (os.access(v1_cpu, os.W_OK) or v2_cpu):
+        pytest.skip(f"no cgroup cpu controller here ({launcher.cgroups!r}): RLIMIT_CPU only")
+    reply, node = run_script(launcher, code, "spinner")
+    try:
+        throttled = _throttled_periods(node.cgroup)
+        assert _cpu_quota(node.cgroup) == (
+            DEFAULT_LIMITS.cpu_quota_us,
+            DEFAULT_LIMITS.cpu_period_us,
+        )
+        if isinstance(reply, Yield):
+            reply = node.shutdown("test over")
+    finally:
+        node.close()
+    message = error_text(reply)
+    wall, cpu = (float(part.split("=")[1]) for part in message.split(": ", 1)[1].split())
+    cores = DEFAULT_LIMITS.cpu_quota_us / DEFAULT_LIMITS.cpu_period_us
+    # One period's worth of slack: the quota is refilled per period, the window cuts one.
+    assert cpu <= cores * wall + DEFAULT_LIMITS.cpu_period_us / 1e6, message
+    # Where the machine left it that much, the node reached its quota and the kernel held it
+    # there (on a machine busy with other work it may never reach it: nothing to throttle).
+    if cpu >= 0.9 * cores * wall:
+        assert throttled > 0, f"the kernel never throttled the spinning node ({message})"
+
+
+def _cpu_quota(group) -> tuple[int, int] | None:
+    """(quota, period) [us] of the node's cpu group: v1's two files or v2's cpu.max."""
+    for directory in group.directories:
+        quota = os.path.join(directory, "cpu.cfs_quota_us")
+        if os.path.exists(quota):
+            with open(quota) as q, open(os.path.join(directory, "cpu.cfs_period_us")) as p:
+                return int(q.read()), int(p.read())
+        cpu_max = os.path.join(directory, "cpu.max")
+        if os.path.exists(cpu_max):
+            with open(cpu_max) as m:
+                quota_text, period_text = m.read().split()
+                return int(quota_text), int(period_text)
+    return None
+
+
+def _throttled_periods(group) -> int:
+    """nr_throttled from the node's cpu group (v1 cpu.stat or v2 cpu.stat), 0 if none."""
+    for directory in group.directories:
+        try:
+            with open(os.path.join(directory, "cpu.stat")) as stat:
+                fields = dict(line.split() for line in stat if line.strip())
+        except OSError:
+            continue
+        if "nr_throttled" in fields:
+            return int(fields["nr_throttled"])
+    return 0
