@@ -9,7 +9,13 @@ What the node sees:
   directory), both tmpfs, gone with the process;
 - every namespace unshared (user, pid, net, ipc, uts, cgroup): no network at all, not even
   loopback; it runs as uid/gid 65534 (nobody) with every capability dropped, in a new session,
-  with a cleared environment, and dies with its parent;
+  and dies with its parent;
+- an environment we build (`sandbox_environment`), never a copy of the server's: bwrap itself is
+  started with it, not only told to `--clearenv` for its child. bwrap is pid 1 inside and any
+  process there may read `/proc/1/environ`, which is the environment bwrap was *started* with
+  (clearenv() changes what a process passes on, not that text): started with the server's, it
+  gave every student the database and Redis URLs and their passwords. The fresh `/proc` of the
+  new pid namespace shows only the sandbox's own processes;
 - the stage-1 seccomp filter (sandbox/seccomp.py), read by bwrap from an inherited fd.
 """
 
@@ -121,11 +127,11 @@ def build_command(
     if server_dir and any(server_dir.startswith(root + os.sep) for root in visible):
         command += ["--tmpfs", server_dir]
     command += ["--ro-bind", sandbox_package_dir(), f"{SANDBOX_ROOT}/sandbox"]
-    env = node_environment(SCRATCH_DIR)
     if font_cache:
         command += ["--ro-bind", font_cache, FONT_CACHE_DIR]
-        env["ROBODOJO_FONT_CACHE"] = FONT_CACHE_DIR
-    for name, value in env.items():
+    # bwrap is started with this same environment (sandbox_environment); --clearenv and these
+    # --setenv make the node's independent of what bwrap was given, should a caller forget.
+    for name, value in sandbox_environment(font_cache).items():
         command += ["--setenv", name, value]
     # The root itself is a tmpfs bwrap made; without this a node could fill memory writing to /.
     command += ["--remount-ro", "/"]
@@ -134,9 +140,26 @@ def build_command(
     return command
 
 
+# PATH inside the sandbox: only /usr is there (/bin links to it). Nothing needs a search path
+# (every program is started by its absolute path), but a student's subprocess call would look.
+SANDBOX_PATH = "/usr/local/bin:/usr/bin:/bin"
+
+
+def sandbox_environment(font_cache: str | None = None) -> dict[str, str]:
+    """The whole environment of a sandbox: what bwrap is started with (the Popen's `env`, so
+    pid 1's /proc/1/environ), and what the node inside gets. Built here from constants, never
+    filtered from os.environ: a variable the server has (a password, a database URL) cannot
+    reach it, whatever it is called."""
+    env = node_environment(SCRATCH_DIR)
+    if font_cache:
+        env["ROBODOJO_FONT_CACHE"] = FONT_CACHE_DIR
+    return env
+
+
 def node_environment(home: str) -> dict[str, str]:
-    """The whole environment of a node (bwrap starts it with a cleared one)."""
+    """The whole environment of a node with `home` as its home and working directory."""
     return {
+        "PATH": SANDBOX_PATH,
         "HOME": home,
         "MPLBACKEND": "Agg",
         "MPLCONFIGDIR": f"{home}/.matplotlib",
@@ -144,7 +167,8 @@ def node_environment(home: str) -> dict[str, str]:
         "OMP_NUM_THREADS": "1",
         "PYTHONDONTWRITEBYTECODE": "1",
         "PYTHONHASHSEED": "0",  # set iteration order is the same in every run
-        "LANG": "C.UTF-8",
+        "LANG": "C.UTF-8",  # UTF-8 text I/O whatever locale the host has
+        "LC_ALL": "C.UTF-8",
     }
 
 
@@ -206,7 +230,7 @@ def probe() -> str | None:
              # every run.
              "--proc", "/proc", "--dev", "/dev",
              "--die-with-parent", "/usr/bin/true"],
-            capture_output=True, text=True, timeout=10,
+            capture_output=True, text=True, timeout=10, env=sandbox_environment(), cwd="/",
         )  # fmt: skip
     except (OSError, subprocess.TimeoutExpired) as error:
         return f"bubblewrap could not start: {error}"

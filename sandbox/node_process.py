@@ -123,7 +123,10 @@ class NodeProcess:
                 command = bwrap.build_command(
                     seccomp_fd, limits.scratch_bytes, [json.dumps(settings)], font_cache
                 )
-                env, cwd = None, None
+                # bwrap (pid 1 inside, its /proc/1/environ readable by the node) and the shell
+                # that moves it into its cgroup start with the sandbox's own environment, in
+                # "/": nothing of the server's environment or working directory goes in.
+                env, cwd = bwrap.sandbox_environment(font_cache), "/"
                 if cgroups is not None:
                     self.cgroup = cgroups.create(limits)
                     command = enter_and_exec(self.cgroup, command)

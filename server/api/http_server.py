@@ -1,5 +1,5 @@
 """How `robodojo serve` runs uvicorn safely: a bound on the time a client may take to send a
-request's headers, and no secret in any log line.
+request's headers (here), and no secret in any log line (server/api/redaction.py).
 
 Header timeout: uvicorn closes idle keep-alive connections (`timeout_keep_alive`) but sets no
 timer between a connection's first byte and the end of its headers, so a client that sends a
@@ -8,52 +8,15 @@ stayed open after 20 s). `h11_with_header_timeout` gives uvicorn's h11 protocol 
 when a connection opens and again when a response completes, that closes the connection if the
 next request's headers are not complete when it fires (nginx's client_header_timeout, the same
 idea). The h11 parser also bounds the headers' size (`h11_max_incomplete_event_size`).
-
-Secrets: invite links carry their token in the query (`/login?token=...`, a websocket's
-`?token=...`); uvicorn logs every path with its query. `RedactTokens` rewrites them as
-`token=***` in uvicorn's access and error loggers (the latter logs websocket paths).
 """
 
 from __future__ import annotations
 
 import asyncio
-import logging
-import re
 from typing import Any
 
 import h11
 from uvicorn.protocols.http.h11_impl import H11Protocol
-
-TOKEN_IN_QUERY = re.compile(r"(?i)(\btoken=)[^&\s\"']+")
-REDACTED_LOGGERS = ("uvicorn.access", "uvicorn.error")
-
-
-def redact(text: str) -> str:
-    return TOKEN_IN_QUERY.sub(r"\1***", text)
-
-
-class RedactTokens(logging.Filter):
-    """Replaces the value of every `token=` in a record's message and arguments."""
-
-    def filter(self, record: logging.LogRecord) -> bool:
-        if isinstance(record.msg, str):
-            record.msg = redact(record.msg)
-        if isinstance(record.args, tuple):
-            record.args = tuple(redact(a) if isinstance(a, str) else a for a in record.args)
-        elif isinstance(record.args, dict):
-            record.args = {
-                key: redact(value) if isinstance(value, str) else value
-                for key, value in record.args.items()
-            }
-        return True
-
-
-def install_redaction() -> None:
-    """After uvicorn configured its logging (uvicorn.Config does, on creation)."""
-    for name in REDACTED_LOGGERS:
-        logger = logging.getLogger(name)
-        if not any(isinstance(f, RedactTokens) for f in logger.filters):
-            logger.addFilter(RedactTokens())
 
 
 def h11_with_header_timeout(header_timeout_s: float) -> type[H11Protocol]:

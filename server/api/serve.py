@@ -38,7 +38,8 @@ def cmd_serve(args: argparse.Namespace) -> int:
 
     from sandbox.launcher import Launcher
     from server.api.app import create_app
-    from server.api.http_server import h11_with_header_timeout, install_redaction
+    from server.api.http_server import h11_with_header_timeout
+    from server.api.redaction import install_redaction
     from server.sim.registry import topic_types
     from server.store.db import Store
     from server.workers.choose import local_worker_count

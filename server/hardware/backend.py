@@ -9,12 +9,14 @@ Run drives either without asking which. `step()` hands over what the robot sent 
 call, timed on the run's clock; `apply()` passes commands through the safety layer
 (server/hardware/safety.py) before the link. The watchdog runs in `step()`: a node that stops
 commanding for 500 ms stops the robot. When the link drops, `step()` raises `RobotLost` and the
-run ends "failed: robot disconnected"; when a sensor topic goes silent past its bound
-(server/hardware/silence.py), `step()` sends zero velocity and raises `RobotSilent`: "failed:
-robot stopped sending Distance for 0.3 s". Every end of a run calls `stop()`: zero velocity and
-LEDs off. What the safety layer sent is recorded beside the student's command: `Control_applied`
-(the Twist on the wire) and, when something changed it, `Control_limit` (which: the MotionLimits
-fields as "max_linear_m_s,max_linear_accel_m_s2", or "watchdog", "stop").
+run ends saying so ("failed: lost the link to the robot: the robot closed the connection");
+when a sensor topic goes silent past its bound (server/hardware/silence.py), `step()` sends zero
+velocity and raises `RobotSilent`: "failed: robot stopped sending Distance for 0.3 s". Every end
+of a run calls `stop()`: zero velocity and LEDs off (server/hardware/rest.py); a robot whose link
+had dropped gets them when it connects again. What the safety layer sent is recorded beside the
+student's command: `Control_applied` (the Twist on the wire) and, when something changed it,
+`Control_limit` (which: the MotionLimits fields as "max_linear_m_s,max_linear_accel_m_s2", or
+"watchdog", "stop").
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ from typing import TYPE_CHECKING, Protocol
 
 from sandbox.msgs.geometry_msgs import Twist, Vector3
 from sandbox.msgs.std_msgs import String
+from server.hardware.rest import rest_message
 from server.hardware.safety import (
     DEFAULT_WATCHDOG_S,
     MotionLimits,
@@ -48,7 +51,6 @@ if TYPE_CHECKING:
 
 POLL_S = 0.005  # [s] how often a realtime run looks for the robot's messages (200 Hz)
 NO_BOUNDS = (-math.inf, -math.inf, math.inf, math.inf)  # a lab bench has no map edges we know
-LEDS_TOPIC = "Leds"  # the CrowBot's LED topic (firmware); LEDs off at every end
 # Recorded beside the student's command (Control, cmd_vel): what the safety layer sent the robot
 # (geometry_msgs/Twist on "<topic>_applied") and, when something changed it, why (std_msgs/String
 # on "<topic>_limit": the MotionLimits fields, "not_finite", "watchdog" or "stop").
@@ -253,14 +255,17 @@ class HardwareRobot:
         return take() if take is not None else []
 
     def stop(self) -> None:
-        """Zero velocity and LEDs off: every end of a run (the link may already be gone)."""
+        """At rest (server/hardware/rest.py: zero velocity, LEDs off): every end of a run. A
+        link already gone takes nothing; the robot is put at rest when it connects again."""
         if not self.link.connected:
             return
         try:
             self._send_zero()
-            if LEDS_TOPIC in self.robot.commands:
-                msg_type = self.robot.commands[LEDS_TOPIC][0]
-                self.link.send(LEDS_TOPIC, msg_type(data=[0, 0, 0]))
+            for topic, (message_class, _) in self.robot.commands.items():
+                if topic in self._velocity_topics:
+                    continue  # zero sent above, through the safety layer's record
+                if (rest := rest_message(topic, message_class)) is not None:
+                    self.link.send(topic, rest)
         except RobotLost:  # gone in between: nothing left to stop
             pass
 

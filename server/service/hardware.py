@@ -11,7 +11,9 @@ CrowBot's WiFi IP): ros_lib has no authentication, so an address no entry has ge
 (closed at accept, see server/hardware/rosserial/admission.py), and a second connection for a
 robot that is in a run is refused so it cannot end that run or feed it readings (the instructor
 sees the conflict in the robot's connection state); an idle robot's reconnection replaces its
-old session (a rebooted robot comes back). A robot must offer the topics of its kind (the
+old session (a rebooted robot comes back), and the old connection is put at rest and closed at
+once: left open, its readings went on reaching the robot's later runs (issue 33, finding 14).
+Only the connection a link was made for feeds it. A robot must offer the topics of its kind (the
 simulated robot's names and types); a mismatch is kept as a problem the instructor sees. The
 rosserial thread hands each message to the link's inbox (`RosserialLink`,
 server/hardware/rosserial/link.py; bounded: latest values win when a run is not reading).
@@ -32,7 +34,7 @@ from collections.abc import Callable
 from server.hardware.health import LinkHealth, RobotHealth, assess
 from server.hardware.queue import RobotQueue, SlotState
 from server.hardware.rosserial import Refusal, RobotConnection, RosserialHandler, RosserialServer
-from server.hardware.rosserial.link import RosserialLink
+from server.hardware.rosserial.link import RosserialLink, link_lost
 from server.hardware.rosserial.messages import LogLevel
 from server.runs.commands import RunCommand, Stop
 from server.sim.registry import get_robot
@@ -187,16 +189,25 @@ class HardwareHub(RosserialHandler):
             log.warning("hardware: %s", refusal.reason)  # it was admitted before the run began
             robot.stop()
             return
+        old = None
         with self._lock:
             # An unregistered robot has no link to read its session's problems from later.
             self._problems[name] = problems if known else problems + list(robot.problems)
             self._conflicts.pop(name, None)
             if known:
                 old = self._links.get(name)
-                if old is not None:
-                    old.lose("the robot connected again")
                 self._links[name] = RosserialLink(robot, name)
                 self._by_connection[robot.id] = name
+                if isinstance(old, RosserialLink):
+                    self._by_connection.pop(old.connection.id, None)
+        if isinstance(old, RosserialLink) and old.connection is not robot:
+            old.lose(
+                link_lost(f"{name} connected again from {address}, which replaced this connection")
+            )
+            # At rest and closed now, outside the lock (its close comes back through
+            # on_robot_disconnected): nothing the old connection sends is read any more.
+            old.connection.stop()
+            log.info("hardware: %s: the new connection replaced %s", name, old.connection.id)
         for problem in problems:
             log.warning("hardware: %s", problem)
 
@@ -204,10 +215,12 @@ class HardwareHub(RosserialHandler):
         with self._lock:
             name = self._by_connection.pop(robot.id, None)
             link = self._links.get(name) if name else None
-            if link is not None and link.connection is robot:
+            if link is None or getattr(link, "connection", None) is not robot:
+                link = None  # another connection's link (it replaced this one): not ours to end
+            else:
                 del self._links[name]
         if link is not None:
-            link.lose("robot disconnected")
+            link.lose(link_lost(reason))
             log.info("hardware: %s disconnected (%s)", name, reason)
 
     def on_message(self, robot: RobotConnection, topic: str, message) -> None:
@@ -221,8 +234,11 @@ class HardwareHub(RosserialHandler):
             link.log(f"[{level.name.lower()}] {line}")
 
     def _link_of(self, robot: RobotConnection) -> RosserialLink | None:
+        """The link made for this very connection, or None: a replaced connection's messages
+        must never reach the link (and the runs) of the one that replaced it."""
         name = self._by_connection.get(robot.id)
-        return self._links.get(name) if name else None
+        link = self._links.get(name) if name else None
+        return link if isinstance(link, RosserialLink) and link.connection is robot else None
 
     # ------------------------------------------------------------------ the service's side
     def link(self, name: str):

@@ -538,6 +538,8 @@ def main() -> None:
         line = {"t": time.monotonic(), "topic": topic, "bytes": size}
         if topic == "Control":
             line["linear"] = message.linear.x  # type: ignore[attr-defined]
+        elif topic == "Leds":
+            line["leds"] = list(message.data)  # type: ignore[attr-defined]
         print(json.dumps(line), flush=True)
 
     robot.on_received = report

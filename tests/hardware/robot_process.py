@@ -27,12 +27,14 @@ REPO = Path(__file__).resolve().parents[2]
 @dataclass(frozen=True, slots=True)
 class Received:
     """One message the emulated robot decoded: its monotonic time [s] (the clock is shared by
-    every process on the machine), topic, frame size [bytes], and Control's linear.x."""
+    every process on the machine), topic, frame size [bytes], Control's linear.x and the Leds'
+    colour."""
 
     t: float
     topic: str
     bytes: int
     linear: float | None = None
+    leds: list[int] | None = None
 
 
 class RobotProcess:

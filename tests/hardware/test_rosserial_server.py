@@ -132,6 +132,31 @@ def test_the_crowbot_negotiates_streams_and_obeys() -> None:
         assert robot_fw.receiver.bad_frames == 0
 
 
+def test_the_handshake_puts_the_robot_at_rest_before_anything_else() -> None:
+    """Issue 33, finding 3: a firmware with no watchdog holds its last command, so the first
+    thing every robot hears on each command topic is its rest: zero velocity, LEDs off."""
+    handler = Recorder(answer=drive_forward)
+    with serving(handler) as server, firmware(server) as robot_fw:
+        assert wait_until(lambda: any(m.linear.x > 0 for m in robot_fw.received_on("Control")))
+        controls = robot_fw.received_on("Control")
+        assert controls[0] == Twist()  # before the first command the handler sent
+        assert [list(m.data) for m in robot_fw.received_on("Leds")] == [[0, 0, 0]]
+        assert robot_fw.received_on("Buzzer") == []  # a note ends by itself: no rest to send
+
+
+def test_a_stop_puts_the_robot_at_rest_before_the_tx_stop() -> None:
+    handler = Recorder(answer=drive_forward)
+    with serving(handler) as server, firmware(server, reconnect=False) as robot_fw:
+        assert wait_until(lambda: any(m.linear.x > 0 for m in robot_fw.received_on("Control")))
+        handler.answer = None
+        (robot,) = handler.connected
+        robot.stop()
+        assert wait_until(lambda: robot_fw.tx_stops == 1)
+        assert robot_fw.received_on("Control")[-1] == Twist()
+        assert list(robot_fw.received_on("Leds")[-1].data) == [0, 0, 0]
+        assert len(robot_fw.received_on("Leds")) == 2  # at the handshake and at the stop
+
+
 def test_an_md5_mismatch_is_reported_with_both_sums() -> None:
     handler = Recorder()
     with serving(handler) as server, firmware(server, wrong_md5=frozenset({"Control"})):

@@ -183,7 +183,8 @@ def test_a_robot_that_disconnects_ends_its_run(bench):
     )
     firmware._close()  # the robot's WiFi drops
     run = wait_for_end(student, run_id, timeout_s=20)
-    assert run["state"] == "failed" and run["reason"] == "failed: robot disconnected"
+    assert run["state"] == "failed", run
+    assert run["reason"] == "failed: lost the link to the robot: the robot closed the connection"
     # The robot comes back and rejoins the pool.
     firmware.stop()
     firmware._stopping.clear()

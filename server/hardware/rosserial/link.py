@@ -8,7 +8,8 @@ drives a Create base through `CreateLink` (server/hardware/create/link.py).
 
 The rosserial thread hands each message to a bounded inbox (latest values win when no run is
 reading). `connected` asks the connection itself, since its session closes before the hub hears
-of it.
+of it; `lost_reason` then says so too, so a run on a link that dropped ends naming the lost link
+("failed: lost the link to the robot: the robot closed the connection"), whoever noticed first.
 """
 
 from __future__ import annotations
@@ -27,14 +28,18 @@ INBOX_MAX = 1000  # messages waiting for a run: ~10 s of the CrowBot's topics; o
 LOG_LINES_KEPT = 200  # per robot, for the instructor
 
 
+def link_lost(reason: str | None) -> str:
+    """The sentence a run on a dropped link ends with; `reason` is the session's."""
+    return f"lost the link to the robot: {reason or 'the connection closed'}"
+
+
 class RosserialLink:
     """A rosserial connection as a `RobotLink` (server/hardware/backend.py)."""
 
     def __init__(self, connection: RobotConnection, name: str) -> None:
         self.connection = connection
         self.name = name
-        self._lost = False
-        self.lost_reason = ""
+        self._lost_reason = ""  # set by lose(): the hub's word on why the link is gone
         self._inbox = ReceivedInbox(INBOX_MAX)
         self._lock = threading.Lock()  # the robot's log lines: rosserial thread -> run
         self.logs: deque[str] = deque(maxlen=LOG_LINES_KEPT)  # the instructor's view
@@ -43,7 +48,16 @@ class RosserialLink:
     @property
     def connected(self) -> bool:
         # The session closes before the hub hears of it: ask the connection itself.
-        return not self._lost and self.connection.connected
+        return not self._lost_reason and self.connection.connected
+
+    @property
+    def lost_reason(self) -> str:
+        """Why the link is gone, as a sentence ("" while connected)."""
+        if self._lost_reason:
+            return self._lost_reason
+        if not self.connection.connected:
+            return link_lost(self.connection.close_reason)
+        return ""
 
     def health(self) -> LinkHealth:
         """In sync (READY, its time requests answered) and when the robot was last heard."""
@@ -66,8 +80,9 @@ class RosserialLink:
         try:
             self.connection.send(topic, message)
         except RobotDisconnected:
-            self.lose("robot disconnected")
-            raise RobotLost("robot disconnected") from None
+            reason = self.lost_reason or link_lost(None)
+            self.lose(reason)
+            raise RobotLost(reason) from None
 
     @property
     def listened_until_s(self) -> float | None:
@@ -96,5 +111,6 @@ class RosserialLink:
         self._inbox.push(topic, message, time.monotonic())
 
     def lose(self, reason: str) -> None:
-        self.lost_reason = reason
-        self._lost = True
+        """The link is gone for good (`reason`, a sentence); the first reason given stays."""
+        if not self._lost_reason:
+            self._lost_reason = reason or link_lost(None)

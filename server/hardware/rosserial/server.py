@@ -35,6 +35,13 @@ newest when it resumes, never a backlog. A robot that advertises no publisher gi
 life, so only the socket bound holds for it. A stop (a zero Twist, or ``send(..., urgent=True)``)
 never waits.
 
+At rest first, always: the moment a robot's handshake names a command topic (its subscriber
+TopicInfo), that topic is sent its rest (server/hardware/rest.py: zero velocity, LEDs off),
+before any handler can write to it; and every stop (``RobotConnection.stop``, the server's own
+``stop``) sends the rest before the tx-stop. A firmware without a watchdog holds its last
+command: reconnected after a dropped link, it would otherwise drive on where the run that
+commanded it had already ended.
+
 Unlike rosserial_python (one connection at a time unless forking) it serves up to
 ``max_connections`` robots at once; it requests topics at once instead of after 2 s (that sleep
 waits for an Arduino to reboot when its serial port opens; a TCP client is already running).
@@ -54,7 +61,10 @@ from collections.abc import Callable
 
 from sandbox.msgs import Message
 from sandbox.msgs.geometry_msgs import Twist
+from server.hardware.rest import rest_message
 from server.hardware.rosserial.admission import AdmissionControl, Refusal
+from server.hardware.rosserial.events import Direction
+from server.hardware.rosserial.frames import encode_frame
 from server.hardware.rosserial.limits import DEFAULT_LIMITS, RosserialLimits
 from server.hardware.rosserial.messages import LogLevel
 from server.hardware.rosserial.session import (
@@ -188,7 +198,8 @@ class RobotConnection:
         return len(self._held)
 
     def stop(self) -> None:
-        """Send the tx-stop frame and close the connection; any thread."""
+        """Put the robot at rest (zero velocity, LEDs off), send the tx-stop frame and close the
+        connection at once; any thread. Nothing it sends afterwards is read."""
         self._server._call_on_loop(self._stop)
 
     def __repr__(self) -> str:
@@ -241,7 +252,21 @@ class RobotConnection:
             if self._may_write(topic):
                 self._write_command(topic, self._held.pop(topic))
 
+    def _put_at_rest(self, topics: list[RobotTopic]) -> None:
+        """Write the rest of each of `topics` now (server/hardware/rest.py), past the
+        latest-wins slots: a stop never waits. Its frame is built from the topic itself, so it
+        goes out in any state, even mid-negotiation."""
+        transport = self._transport
+        if transport is None or transport.is_closing():
+            return
+        for topic in topics:
+            message = rest_message(topic.name, topic.message_class)
+            if message is not None:
+                self._held.pop(topic.name, None)  # a command that waited is older than this
+                self._write_command(topic.name, encode_frame(topic.topic_id, message.serialize()))
+
     def _stop(self) -> None:
+        self._put_at_rest(list(self.session.subscribers.values()))
         self._server._dispatch(self, self.session.stop())
 
     def _flush(self) -> None:
@@ -477,7 +502,7 @@ class RosserialServer:
 
     async def _shutdown(self) -> None:
         for robot in list(self._robots.values()):
-            self._dispatch(robot, robot.session.stop())
+            robot._stop()  # at rest, then tx-stop
         if self._listener is not None:
             self._listener.close()
             await self._listener.wait_closed()
@@ -568,6 +593,8 @@ class RosserialServer:
                 self._call(handler.on_robot_connected, robot)
             elif isinstance(event, TopicRegistered):
                 topic = event.topic
+                if topic.direction is Direction.SUBSCRIBES:
+                    robot._put_at_rest([topic])  # before anyone can command it (docstring)
                 logger.info(
                     "rosserial %s: setup %s on %s [%s]",
                     robot.id,
