@@ -11,7 +11,8 @@ call, timed on the run's clock; `apply()` passes commands through the safety lay
 commanding for 500 ms stops the robot. When the link drops, `step()` raises `RobotLost` and the
 run ends saying so ("failed: lost the link to the robot: the robot closed the connection");
 when a sensor topic goes silent past its bound (server/hardware/silence.py), `step()` sends zero
-velocity and raises `RobotSilent`: "failed: robot stopped sending Distance for 0.3 s". Every end
+velocity and raises `RobotSilent`: "failed: robot stopped sending Distance for 0.3 s", naming a
+topic the run's nodes read when several went silent (`note_readers`). Every end
 of a run calls `stop()`: zero velocity and LEDs off (server/hardware/rest.py); a robot whose link
 had dropped gets them when it connects again. What the safety layer sent is recorded beside the
 student's command: `Control_applied` (the Twist on the wire) and, when something changed it,
@@ -25,6 +26,7 @@ import contextlib
 import math
 import time
 from collections import deque
+from collections.abc import Callable
 from typing import TYPE_CHECKING, Protocol
 
 from sandbox.msgs.geometry_msgs import Twist, Vector3
@@ -140,6 +142,7 @@ class HardwareRobot:
         }
         self.silence_limits = silence_limits
         self.silence: SensorSilenceWatchdog | None = None  # made by reset()
+        self._is_read: Callable[[str], bool] | None = None  # see note_readers()
         # (topic, Twist sent, limits that changed it), published by step() (any thread adds).
         self._applied: deque[tuple[str, Twist, tuple[str, ...]]] = deque(maxlen=APPLIED_KEPT)
 
@@ -178,6 +181,11 @@ class HardwareRobot:
 
     def drain_events(self) -> list[SimEvent]:
         return []  # contacts and bounds are the simulator's to see
+
+    def note_readers(self, is_read: Callable[[str], bool]) -> None:
+        """`is_read(topic)`: does a node of the run read it now? A robot that froze stops every
+        topic at once; the silence named is then one the student's code was waiting for."""
+        self._is_read = is_read
 
     def read(self, topic: str) -> object | None:
         return self._latest.get(topic)
@@ -229,7 +237,7 @@ class HardwareRobot:
             silence.heard(topic, received_s)
         now = self._clock()
         heard_until_s = now if listened_s is None else min(now, listened_s)
-        if (silent := silence.check(heard_until_s)) is not None:
+        if (silent := silence.check(heard_until_s, self._is_read)) is not None:
             self._stop_wheels()
             raise RobotSilent(silent.sentence)
         if self.watchdog.expired(now) and not self._zero_sent:

@@ -11,11 +11,16 @@ its bound the watchdog names it, and HardwareRobot sends zero velocity and ends 
 A topic the link says the robot publishes is watched from the start of the run: a robot that
 never sends one trips the watchdog as one that stopped. Pure: times are passed in, so the tests
 drive them.
+
+A robot that freezes stops all its topics at once, and the one heard least recently trips first:
+a run whose node reads only Distance once ended "robot stopped sending Light". When a topic
+trips, one the run's nodes read that is silent too (past `together_fraction` of its bound) is
+named instead, since that is the silence the student's code saw (`check(now_s, is_read)`).
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
 
@@ -26,6 +31,7 @@ class SilenceLimits:
     periods: float
     min_bound_s: float
     default_rate_hz: float
+    together_fraction: float
 
     def bound_s(self, rate_hz: float | None) -> float:
         """[s] the longest silence allowed to a topic published at `rate_hz`."""
@@ -43,6 +49,11 @@ SILENCE_LIMITS = SilenceLimits(
     min_bound_s=0.3,
     # [Hz] a topic whose model gives no rate (event topics): assume 2 Hz, i.e. a 2.5 s bound.
     default_rate_hz=2.0,
+    # [fraction of a bound] when one topic trips, another silent for this share of its own
+    # bound went silent with it: topics of one robot trip at most one period apart (50 ms at
+    # 20 Hz, a sixth of the 300 ms bound), while a topic that is merely between two readings
+    # has been silent for at most a period or two, well under half.
+    together_fraction=0.5,
 )
 
 
@@ -89,12 +100,30 @@ class SensorSilenceWatchdog:
         if last is not None and at_s > last:
             self._last_s[topic] = at_s
 
-    def check(self, now_s: float) -> Silence | None:
-        """The topic silent longest past its bound, or None while every one is within it."""
-        worst: Silence | None = None
-        for topic, bound_s in self.bounds_s.items():
-            silent_s = now_s - self._last_s[topic]
-            past_s = silent_s - bound_s
-            if past_s > 0 and (worst is None or past_s > worst.silent_s - worst.bound_s):
-                worst = Silence(topic, silent_s, bound_s)
-        return worst
+    def check(self, now_s: float, is_read: Callable[[str], bool] | None = None) -> Silence | None:
+        """The silence to report at `now_s` [s], or None while every topic is within its bound.
+        Of the topics past their bound, the one silent longest past it; but if `is_read` (does
+        a node of the run read this topic?) names topics that are silent too (past
+        `together_fraction` of their bound), the longest silent of those instead."""
+        silences = [
+            Silence(topic, now_s - self._last_s[topic], bound_s)
+            for topic, bound_s in self.bounds_s.items()
+        ]
+        tripped = [silence for silence in silences if silence.silent_s > silence.bound_s]
+        if not tripped:
+            return None
+        if is_read is not None:
+            together = self.limits.together_fraction
+            read = [
+                silence
+                for silence in silences
+                if silence.silent_s > together * silence.bound_s and is_read(silence.topic)
+            ]
+            if read:
+                return max(read, key=_past_bound)
+        return max(tripped, key=_past_bound)
+
+
+def _past_bound(silence: Silence) -> float:
+    """[s] how far a silence is past its bound (negative: within it)."""
+    return silence.silent_s - silence.bound_s

@@ -153,6 +153,7 @@ class RunCore:
         self.outputs.add(RecordingSink(self.recorder), first=True)
         self.edge = RobotEdge(self.sim, dialect, self.bus, self.outputs, self.faults, self.run_id)
         self.edge.declare(self.recorder)
+        self.sim.note_readers(self.bus.has_subscribers)  # a silent real robot names these first
         if spec.light_position is not None:
             movable = [light.name for light in self.sim.lights if light.movable]
             if movable:

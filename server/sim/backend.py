@@ -16,6 +16,8 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Protocol, runtime_checkable
 
 if TYPE_CHECKING:
+    from collections.abc import Callable
+
     from server.sim.robots.base import RobotModel, TopicSpec
     from server.sim.simulation import Published, SimEvent
     from server.sim.state import Pose2D, RobotState
@@ -67,6 +69,11 @@ class RobotBackend(Protocol):
         ...
 
     def drain_events(self) -> list[SimEvent]: ...
+
+    def note_readers(self, is_read: Callable[[str], bool]) -> None:
+        """`is_read(topic)`: whether a node of the run reads that topic now (the run's bus).
+        A real robot that goes silent names such a topic first; a simulation has no use for it."""
+        ...
 
     def press_button(self, pressed: bool) -> None: ...
 

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import math
 import zlib
+from collections.abc import Callable
 
 import numpy as np
 
@@ -257,6 +258,9 @@ class Simulation:
         """Contact and bounds events since the last call."""
         events, self._events = self._events, []
         return events
+
+    def note_readers(self, is_read: Callable[[str], bool]) -> None:
+        """Which topics the run's nodes read: a simulated robot never goes silent, so unused."""
 
     # ----------------------------------------------------------------------------- time
     def step(self, dt_s: float) -> list[Published]:

@@ -185,6 +185,41 @@ def test_a_robot_that_stops_sending_ends_the_run_and_is_stopped(tmp_path, launch
     assert not [t for t, m in sent if m.linear.x and t > stops[0]]  # nothing moved it after
 
 
+class FakeCrowBotAllSensors(FakeCrowBot):
+    """A CrowBot that says it publishes Distance, Light and Line and sends all three at 20 Hz,
+    Light 10 ms before the others (as a firmware's loop sends them in turn)."""
+
+    publishes = frozenset({"Distance", "Light", "Line"})
+
+    def _publish(self) -> None:
+        while not self._stop.wait(0.05):
+            if self.frozen.is_set():
+                continue
+            now = time.monotonic()
+            with self._lock:
+                self._received.append(("Light", LIGHT(data=[100, 100]), now - 0.01))
+                self._received.append(("Line", LIGHT(data=[0, 0]), now))
+                self._received.append(("Distance", Int32(data=42), now))
+
+
+LIGHT = get_message_class("std_msgs/Int32MultiArray")
+
+
+def test_a_frozen_robot_is_said_to_have_stopped_sending_what_the_node_reads(tmp_path, launcher):
+    """Every topic stops at once; Light, heard last 10 ms earlier, trips first, but the node
+    reads only Distance: the run's end names Distance (issue 33)."""
+    robot = FakeCrowBotAllSensors()
+    try:
+        backend = HardwareRobot("crowbot", robot, LIMITS)
+        run = Run(spec(DRIVER, duration_s=10.0), launcher, tmp_path / "run", backend=backend)
+        threading.Timer(1.0, robot.frozen.set).start()
+        result = run.execute()
+    finally:
+        robot.close()
+    assert result.state is RunState.FAILED
+    assert result.reason == "failed: robot stopped sending Distance for 0.3 s"
+
+
 def test_a_real_robot_needs_the_realtime_clock(tmp_path, launcher, robot):
     with pytest.raises(RunSpecError, match="realtime"):
         Run(spec(DRIVER, clock=Clock.LOCKSTEP), launcher, tmp_path / "run",

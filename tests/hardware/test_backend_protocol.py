@@ -39,7 +39,7 @@ def test_the_protocol_declares_what_a_run_uses() -> None:
     assert _protocol_members(RobotBackend) >= {
         "robot", "world", "lights", "state", "topics", "time_s", "tick_s", "odometry_origin",
         "reset", "step", "apply", "read", "next_publication_s", "drain_events", "press_button",
-        "move_light", "stop", "take_logs",
+        "move_light", "stop", "take_logs", "note_readers",
     }  # fmt: skip
 
 

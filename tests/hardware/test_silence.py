@@ -50,3 +50,26 @@ def test_silence_counts_from_the_start_of_the_run_at_the_earliest():
     watchdog.watch("Distance", 20.0, since_s=40.0)  # a reading from before the run
     assert watchdog.check(50.25) is None
     assert watchdog.check(50.35).topic == "Distance"
+
+
+def test_when_several_go_silent_the_topic_the_nodes_read_is_named():
+    """A robot that froze stops every topic at once; the one heard least recently (Light, here
+    20 ms before Distance) trips first, but the node reads only Distance (issue 33)."""
+    rates = {"Distance": 20.0, "Light": 20.0, "Line": 20.0}
+    watchdog = SensorSilenceWatchdog(rates, start_s=0.0)
+    watchdog.heard("Light", 1.00)
+    watchdog.heard("Line", 1.01)
+    watchdog.heard("Distance", 1.02)
+    assert watchdog.check(1.301).topic == "Light"  # no word on what is read: as before
+    silence = watchdog.check(1.301, is_read=lambda topic: topic == "Distance")
+    assert silence.topic == "Distance"
+    assert silence.sentence == "robot stopped sending Distance for 0.3 s"
+    assert watchdog.check(1.29, is_read=lambda topic: topic == "Distance") is None
+
+
+def test_a_read_topic_still_arriving_does_not_take_the_blame():
+    watchdog = SensorSilenceWatchdog({"Distance": 20.0, "Light": 20.0}, start_s=0.0)
+    watchdog.heard("Light", 1.0)
+    watchdog.heard("Distance", 1.28)  # still arriving: heard 21 ms before the check
+    silence = watchdog.check(1.301, is_read=lambda topic: topic == "Distance")
+    assert silence.sentence == "robot stopped sending Light for 0.3 s"
