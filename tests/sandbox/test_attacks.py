@@ -5,6 +5,7 @@ stand-in for the server) unharmed, and leave a node running beside it on time.""
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import os
 import socket
@@ -132,13 +133,29 @@ def test_deep_recursion_is_contained(launcher):
     assert exited.error.line == 2
 
 
+@contextlib.contextmanager
+def patient(launcher):
+    """A launcher like `launcher` with the lab's own first-step budget (10 s), not the tests'
+    short one, for an attack whose containment is under test, not its speed: on a loaded
+    machine a node filling its memory cap takes seconds of wall time to get there (seen: a
+    recursion 10**7 deep killed by the 4 s budget before it crashed)."""
+    limits = dataclasses.replace(
+        launcher.limits, first_step_budget_s=DEFAULT_LIMITS.first_step_budget_s
+    )
+    made = type(launcher)(limits=limits, pool_size=launcher.pool_size)
+    try:
+        yield made
+    finally:
+        made.close()
+
+
 def test_c_stack_overflow_crashes_only_the_node(launcher):
     code = (
         "import sys\nsys.setrecursionlimit(10**7)\ndef dive(n):\n    return dive(n + 1)\ndive(0)\n"
     )
-    with Bystander(launcher):
-        exited = finish(launcher, code)
-    assert exited.outcome in (Outcome.CRASHED, Outcome.ERROR)
+    with patient(launcher) as lab_budget, Bystander(lab_budget):
+        exited = finish(lab_budget, code)
+    assert exited.outcome in (Outcome.CRASHED, Outcome.ERROR), exited
 
 
 def test_print_flood_is_truncated_with_a_note(launcher):
@@ -352,18 +369,10 @@ def test_touched_memory_is_capped_by_the_cgroup_or_the_rlimit(launcher):
     code = (
         "import numpy as np\nhog = []\nfor _ in range(100):\n    hog.append(np.ones(20_000_000))\n"
     )
-    # The lab's own first-step budget (10 s), not the tests' short one: on a loaded machine a
-    # warm node pressing on its cgroup's cap reclaims its libraries' page cache for seconds
+    # A warm node pressing on its cgroup's cap reclaims its libraries' page cache for seconds
     # before the kernel kills it (seen: the 4 s budget fired first), and the cap is under test.
-    limits = dataclasses.replace(
-        launcher.limits, first_step_budget_s=DEFAULT_LIMITS.first_step_budget_s
-    )
-    patient = type(launcher)(limits=limits, pool_size=launcher.pool_size)
-    try:
-        with Bystander(patient):
-            exited = finish(patient, code)
-    finally:
-        patient.close()
+    with patient(launcher) as lab_budget, Bystander(lab_budget):
+        exited = finish(lab_budget, code)
     if launcher.cgroups is not None:
         assert exited.outcome is Outcome.CRASHED
         assert "ran out of memory (its cap is 768 MiB)" in exited.reason
