@@ -1,8 +1,10 @@
 """Every limit a sandboxed node runs under, in one table, each with the reason for its value.
 
 The launcher applies the process limits (rlimits, tmpfs size, step budget); the node host applies
-the artifact caps when it collects files; the parent applies the log caps while it drains the
-node's output. Change a value here and every layer follows.
+the artifact caps when it collects files, and the parent again as it receives them
+(sandbox/artifact_intake.py: the collector runs in the student's process, which can replace it);
+the parent applies the log caps while it drains the node's output. Change a value here and every
+layer follows.
 """
 
 from __future__ import annotations
@@ -57,10 +59,16 @@ class Limits:
     # its files. Two 2400x1200 PNGs, as the CrowBot paper's scripts save, take ~2 s on a quiet
     # 2-core machine and several times that under load; 30 s is generous and still bounded.
     shutdown_budget_s: float = 30.0
-    # Artifacts collected from the scratch directory at the end of a run.
+    # Artifacts collected from the scratch directory at the end of a run, and checked again by
+    # the server as they arrive: figures, CSV logs and a map or two, not a disk filler. A run's
+    # files count in its student's disk budget only once it has ended, so these bound what one
+    # run can add past the budget.
     artifact_file_bytes: int = 8 * MiB
     artifact_total_bytes: int = 24 * MiB
     artifact_count: int = 32
+    # An artifact's name (its path in the scratch directory): far past any a node saves, short
+    # enough for a log line and a listing.
+    artifact_name_chars: int = 1024
     # Log stream: what one node may print over a run; beyond it lines are dropped with a note.
     log_total_bytes: int = 1 * MiB
     log_line_bytes: int = 4096

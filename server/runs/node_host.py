@@ -9,7 +9,9 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 
+from sandbox.artifact_intake import within_run_room
 from sandbox.launcher import Launcher
+from sandbox.limits import DEFAULT_LIMITS
 from sandbox.node_process import NodeState
 from sandbox.protocol import Artifact, Envelope, Exited, Finishing, NodeInfo, Outcome, Yield
 from sandbox.units import NS_PER_S
@@ -33,6 +35,7 @@ class NodeHost:
         self.bus = bus
         self.outputs = outputs
         self.route = route
+        self._artifact_room_bytes = DEFAULT_LIMITS.artifact_total_bytes  # start(): launcher's
 
     # ----------------------------------------------------------------------------- start, end
     def start(
@@ -41,6 +44,7 @@ class NodeHost:
         info: Callable[[NodeSpec], NodeInfo],
         files: tuple[tuple[str, bytes], ...],
     ) -> None:
+        self._artifact_room_bytes = launcher.limits.artifact_total_bytes
         for slot in self.order:
             self.bus.add_node(slot.name)
             slot.process = launcher.start(slot.name)
@@ -86,9 +90,13 @@ class NodeHost:
             slot.exited = exited
             self._collect_logs(slot)
             if recorder is not None and exited.artifacts:
+                # Each node's files were held to the caps as they arrived (NodeProcess); the
+                # total cap holds for the run's nodes together too.
+                exited = within_run_room(exited, process.limits, self._artifact_room_bytes)
+                self._artifact_room_bytes -= sum(len(a.data) for a in exited.artifacts)
                 recorder.write_artifacts(slot.name, [(a.name, a.data) for a in exited.artifacts])
-            for note in exited.notes:
-                slot.logs.append(f"[artifacts] {note}")
+            if exited.notes:  # what the collector skipped, what the server refused: in the log
+                slot.log([f"[artifacts] {note}" for note in exited.notes], self.outputs)
         finally:
             process.close()
             slot.process = None
