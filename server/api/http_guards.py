@@ -5,6 +5,11 @@ middleware (no request object built, nothing buffered):
   413 as soon as they pass the limit (a Content-Length over it is refused before a byte is read).
   Starlette's `Request.body()` assembles the whole body in memory; counting has to happen in
   `receive` (ASGI spec, "HTTP Connection Scope": http.request messages with more_body).
+- `BodyPace` is how long a request body may take, once its headers are in: whole within a
+  timeout, and at a minimum average rate after a grace (Apache mod_reqtimeout's `body=..,MinRate`
+  idea). uvicorn has no timer while a body arrives, so 50 connections sending a login body 1 byte
+  every 4 s stayed open past 72 s; its h11 protocol (server/api/http_server.py) enforces this,
+  answering 408 with `too_slow_detail`.
 - `SecurityHeaders` adds a Content-Security-Policy, frame-ancestors / X-Frame-Options, nosniff
   and a Referrer-Policy to every response that does not set its own (the proxied 3D view does).
   The policy allows what web/index.html, web/admin.html and their bundles load: scripts and
@@ -17,6 +22,7 @@ from __future__ import annotations
 
 import json
 from collections.abc import Awaitable, Callable, MutableMapping
+from dataclasses import dataclass
 from typing import Any
 
 Scope = MutableMapping[str, Any]
@@ -54,6 +60,28 @@ def too_large_detail(max_bytes: int) -> str:
         f"the request body is larger than {max_bytes} bytes, the lab's limit for any request; "
         "send less (a workspace file over the limit belongs in several smaller files)"
     )
+
+
+@dataclass(frozen=True, slots=True)
+class BodyPace:
+    """How long a request body may take after its headers (settings.py says why each value)."""
+
+    timeout_s: float  # [s] the whole body, however fast it comes
+    min_rate_bytes_s: float  # [B/s] on average, counted once the grace is over
+    grace_s: float  # [s] before the rate counts
+
+    def deadline_s(self, received_bytes: int) -> float:
+        """[s] after the headers, when a body with `received_bytes` in is too slow: each
+        `min_rate_bytes_s` received buys a second past the grace, up to the timeout."""
+        return min(self.timeout_s, self.grace_s + received_bytes / self.min_rate_bytes_s)
+
+    def too_slow_detail(self) -> str:
+        return (
+            f"the request body arrived too slowly: a body must be complete within "
+            f"{self.timeout_s:g} s of its headers, and after its first {self.grace_s:g} s "
+            f"arrive at {self.min_rate_bytes_s:g} bytes a second or faster; send it again "
+            "from a faster connection"
+        )
 
 
 class BodyLimit:

@@ -38,7 +38,8 @@ def cmd_serve(args: argparse.Namespace) -> int:
 
     from sandbox.launcher import Launcher
     from server.api.app import create_app
-    from server.api.http_server import h11_with_header_timeout
+    from server.api.http_guards import BodyPace
+    from server.api.http_server import h11_with_timeouts
     from server.api.redaction import install_redaction
     from server.sim.registry import topic_types
     from server.store.db import Store
@@ -64,8 +65,15 @@ def cmd_serve(args: argparse.Namespace) -> int:
             host=settings.host,
             port=settings.port,
             log_level="info",
-            # h11 (not httptools) for its header size bound and our header timeout.
-            http=h11_with_header_timeout(settings.header_timeout_s),
+            # h11 (not httptools) for its header size bound and our header and body timeouts.
+            http=h11_with_timeouts(
+                settings.header_timeout_s,
+                BodyPace(
+                    timeout_s=settings.body_timeout_s,
+                    min_rate_bytes_s=settings.body_min_rate_bytes_s,
+                    grace_s=settings.body_rate_grace_s,
+                ),
+            ),
             h11_max_incomplete_event_size=settings.max_header_bytes,
             timeout_keep_alive=settings.keep_alive_timeout_s,
             ws_max_size=1024 * 1024,  # [B] a websocket command is tiny; a megabyte is abuse

@@ -84,6 +84,13 @@ class Settings(BaseSettings):
     # HTTP connections (uvicorn, h11): a client that holds a connection without finishing a
     # request must not hold it for long; 150 half-sent requests once stayed open forever.
     header_timeout_s: float = Field(10.0, gt=0)  # [s] request line and headers must be in by then
+    # A request body, from the end of its headers: whole within body_timeout_s, and after its
+    # first body_rate_grace_s at body_min_rate_bytes_s on average (each that many bytes buys a
+    # second); else 408 and closed, before any route or login (50 login bodies sent 1 byte
+    # every 4 s once stayed open past 72 s).
+    body_timeout_s: float = Field(60.0, gt=0)  # [s] the largest body (4 MiB) at 0.6 Mbit/s
+    body_min_rate_bytes_s: float = Field(1024.0, gt=0)  # [B/s] 8 kbit/s: any working link
+    body_rate_grace_s: float = Field(10.0, gt=0)  # [s] a slow start, as the headers get
     keep_alive_timeout_s: int = Field(5, ge=1)  # [s] idle between requests (uvicorn's default)
     max_header_bytes: int = Field(32 * KIB, ge=1024)  # [B] request line + headers (h11: 16 KiB)
 

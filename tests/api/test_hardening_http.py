@@ -1,7 +1,8 @@
-"""Issue 14, findings 1, 5 and 6 (headers, header timeout): attacks on a real `robodojo serve`
-over real sockets. A chunked body is counted as it arrives and refused with 413 before it is
-assembled; a request whose headers never finish is closed; a login token never reaches the log;
-every page, file and API answer carries the security headers."""
+"""Issue 14, findings 1, 5 and 6 (headers, header timeout), issue 33, finding 12 (body
+timeout): attacks on a real `robodojo serve` over real sockets. A chunked body is counted as it
+arrives and refused with 413 before it is assembled; a request whose headers never finish is
+closed; a body that arrives too slowly is answered 408 and closed; a login token never reaches
+the log; every page, file and API answer carries the security headers."""
 
 from __future__ import annotations
 
@@ -15,10 +16,15 @@ from pathlib import Path
 import httpx
 import pytest
 
-from server.api.http_guards import CONTENT_SECURITY_POLICY
+from server.api.http_guards import CONTENT_SECURITY_POLICY, BodyPace
 from tests.api.conftest import LabServer, start_server, stop_server
 
 HEADER_TIMEOUT_S = 2.0  # [s] short, so the slow-headers test is quick
+# Short body timeouts too: a body must be whole within BODY_TIMEOUT_S and, after its first
+# BODY_GRACE_S, arrive at BODY_MIN_RATE bytes a second on average.
+BODY_TIMEOUT_S = 6.0  # [s]
+BODY_GRACE_S = 2.0  # [s]
+BODY_MIN_RATE = 1000  # [B/s]
 MAX_BODY_BYTES = 1024 * 1024  # [B] a smaller limit than the default, so growth stands out
 CHUNK_BYTES = 64 * 1024  # [B] one chunk of the attacker's body
 ATTACK_BYTES = 10 * 1024 * 1024  # [B] the chunked body sent: ten times the limit
@@ -33,6 +39,9 @@ def guarded(tmp_path_factory) -> Iterator[LabServer]:
         tmp_path_factory.mktemp("hardening-http"),
         {
             "ROBODOJO_HEADER_TIMEOUT_S": str(HEADER_TIMEOUT_S),
+            "ROBODOJO_BODY_TIMEOUT_S": str(BODY_TIMEOUT_S),
+            "ROBODOJO_BODY_RATE_GRACE_S": str(BODY_GRACE_S),
+            "ROBODOJO_BODY_MIN_RATE_BYTES_S": str(BODY_MIN_RATE),
             "ROBODOJO_MAX_REQUEST_BODY_BYTES": str(MAX_BODY_BYTES),
             "ROBODOJO_SANDBOX_POOL": "0",
         },
@@ -176,6 +185,95 @@ def test_headers_that_never_finish_are_closed(guarded):
         time.sleep(HEADER_TIMEOUT_S / 4)  # the behaviour under test: slow, yet in time
         sock.sendall(b"Connection: close\r\n\r\n")
         assert read_response(sock).startswith(b"HTTP/1.1 200 ")
+
+
+def slow_bodies(
+    server: LabServer, requests: list[bytes], every_s: float, piece: bytes, give_up_s: float
+) -> list[tuple[bytes, float | None]]:
+    """Opens a connection per request head, then sends `piece` on each every `every_s` [s]
+    until the server closes it. Returns per connection what it answered and when [s] it
+    closed (None: still open after `give_up_s`)."""
+    sockets = [
+        socket.create_connection(("127.0.0.1", port_of(server)), timeout=10) for _ in requests
+    ]
+    answers = {sock: b"" for sock in sockets}
+    closed_at: dict[socket.socket, float] = {}
+    for sock, head in zip(sockets, requests, strict=True):
+        sock.sendall(head)
+    started = time.monotonic()
+    next_piece = started
+    try:
+        while len(closed_at) < len(sockets) and time.monotonic() - started < give_up_s:
+            if time.monotonic() >= next_piece:  # the behaviour under test: a slow sender
+                for sock in sockets:
+                    if sock not in closed_at:
+                        with contextlib.suppress(OSError):
+                            sock.send(piece)
+                next_piece += every_s
+            waiting = [sock for sock in sockets if sock not in closed_at]
+            wait_s = max(0.0, min(next_piece - time.monotonic(), 0.2))
+            readable, _, _ = select.select(waiting, [], [], wait_s)
+            for sock in readable:
+                try:
+                    part = sock.recv(65536)
+                except ConnectionResetError:
+                    part = b""
+                answers[sock] += part
+                if not part:
+                    closed_at[sock] = time.monotonic() - started
+    finally:
+        for sock in sockets:
+            sock.close()
+    return [(answers[sock], closed_at.get(sock)) for sock in sockets]
+
+
+SLOW_LOGIN = (
+    b"POST /api/session HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\n"
+    b"Content-Length: 1000\r\n\r\n"
+)
+
+
+def test_a_body_sent_a_byte_at_a_time_is_answered_408_and_closed(guarded):
+    """Issue 33, finding 12: 50 connections sending a login body 1 byte every 4 s stayed open
+    past 72 s. Here 50 send one a second (the same attack, shorter): every one is answered 408
+    with a sentence and closed once the grace is over, the rate far below the minimum; and so
+    are connections answered at once (405) whose client trickles a body nobody reads."""
+    unread = b"POST /api/health HTTP/1.1\r\nHost: x\r\nContent-Length: 1000\r\n\r\n"
+    results = slow_bodies(guarded, [SLOW_LOGIN] * 50 + [unread] * 5, 1.0, b"{", give_up_s=20.0)
+    still_open = sum(closed is None for _, closed in results)
+    assert still_open == 0, f"{still_open} of {len(results)} slow bodies were still open after 20 s"
+    latest_s = max(closed for _, closed in results)
+    assert latest_s < BODY_GRACE_S + 3.0, f"the last slow body was closed after {latest_s:.1f} s"
+    for answer, _ in results[:50]:
+        assert answer.startswith(b"HTTP/1.1 408 "), answer[:300]
+        assert b"the request body arrived too slowly" in answer, answer[-400:]
+        assert b"x-content-type-options: nosniff" in answer.lower()
+    for answer, _ in results[50:]:
+        assert answer.startswith(b"HTTP/1.1 405 "), answer[:300]
+    assert httpx.get(f"{guarded.url}/api/health", timeout=10).status_code == 200
+    # The routes waiting for those bodies were told the client left: nothing went wrong.
+    assert not [line for line in guarded.output if "Exception in ASGI" in line], guarded.output
+
+
+def test_the_body_pace_buys_a_second_per_minimum_rate_up_to_the_timeout():
+    pace = BodyPace(timeout_s=60.0, min_rate_bytes_s=1024.0, grace_s=10.0)
+    assert pace.deadline_s(0) == 10.0  # a byte every 4 s: cut after the grace
+    assert pace.deadline_s(10 * 1024) == 20.0
+    assert pace.deadline_s(4 * 1024 * 1024) == 60.0  # however fast: the whole body by 60 s
+    assert (
+        "within 60 s" in pace.too_slow_detail() and "1024 bytes a second" in pace.too_slow_detail()
+    )
+
+
+@pytest.mark.slow
+def test_a_body_fast_enough_but_too_long_in_coming_is_cut_at_the_timeout(guarded):
+    """5 kB every 0.25 s (20 kB/s, twenty times the minimum rate) of a 200 kB body would take
+    10 s: the whole body has BODY_TIMEOUT_S."""
+    head = SLOW_LOGIN.replace(b"Content-Length: 1000", b"Content-Length: 200000")
+    [(answer, closed_s)] = slow_bodies(guarded, [head], 0.25, b" " * 5000, give_up_s=20.0)
+    assert closed_s is not None and BODY_TIMEOUT_S - 0.5 < closed_s < BODY_TIMEOUT_S + 2.0
+    assert answer.startswith(b"HTTP/1.1 408 "), answer[:300]
+    assert f"within {BODY_TIMEOUT_S:g} s".encode() in answer, answer[-400:]
 
 
 def test_oversized_headers_are_refused(guarded):
