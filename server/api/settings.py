@@ -39,6 +39,12 @@ class Settings(BaseSettings):
     # Limits that protect the lab: value and why.
     max_runs_per_student: int = Field(2, ge=1)  # two: one running, one being looked at
     max_runs_total: int = Field(24, ge=1)  # ~a class; each node is a process of ~65 MiB
+    # Sandboxes: every sandbox job of a student (a run, whose nodes are a sandbox each; a Python
+    # launch file being read) counts against one budget, each sandbox at its memory cap (768 MiB,
+    # sandbox/limits.py): 8 launch files read at once once took 2.6 GiB beside the run limit.
+    max_sandbox_jobs_per_student: int = Field(3, ge=1)  # two runs and a launch file being read
+    student_sandbox_memory_bytes: int = Field(8 * GIB, ge=0)  # [B] ten sandboxes: an 8-node run
+    # and a 2-node one, or two runs of 4 and a launch file; 0 = no memory budget
     max_run_duration_s: float = Field(600.0, gt=0)  # [s] ten minutes of robot time
     max_code_bytes_per_file: int = Field(256 * KIB, ge=1)  # [B] far beyond any exercise
     max_code_bytes_per_run: int = Field(1024 * KIB, ge=1)  # [B] all nodes of one run

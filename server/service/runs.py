@@ -20,10 +20,12 @@ import logging
 import threading
 import time
 import uuid
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from sandbox.launcher import Launcher
+from sandbox.limits import DEFAULT_LIMITS
 from sandbox.protocol import Clock
 from server.exercises.grading import cases_of, run_spec
 from server.hardware.queue import QueueError
@@ -32,10 +34,12 @@ from server.runs.spec import NodeSpec, RunSpec
 from server.runs.state import RunState
 from server.service import disk
 from server.service.catalog import ExerciseEntry
+from server.service.sandbox_budget import SandboxBudget
 from server.service.telemetry import RunTelemetry
 from server.sim.world import LightSource
 from server.store import robots as inventory
 from server.store import runs as run_store
+from server.store import sandbox_leases
 from server.store.db import Store
 from server.store.models import RunRecord
 from server.store.runs import RunFilter
@@ -100,6 +104,14 @@ class RunService:
         if executor is None:
             executor = make_executor(settings, store, launcher, hardware)
         self.executor = executor
+        # Every sandbox job of a student counts against one budget (server/service/
+        # sandbox_budget.py); a launch file's job holds its lease for at most its sandbox's
+        # start, first step and end budgets (a web process that died frees it then).
+        limits = launcher.limits if launcher is not None else DEFAULT_LIMITS
+        self.sandbox_budget = SandboxBudget.from_settings(settings, limits.memory_bytes)
+        self._launch_lease_s = (
+            limits.startup_budget_s + limits.first_step_budget_s + limits.shutdown_budget_s
+        )
         self._lock = threading.Lock()  # one start at a time here: counted, then stored
         self._closing = False
         if hardware is not None:  # a run past its robot's time slot is told to stop
@@ -177,7 +189,7 @@ class RunService:
                 # (an advisory lock on PostgreSQL): every web process of the lab agrees, and two
                 # admitting at once cannot both pass a count neither has added to yet.
                 with self.store.exclusive_session() as db:
-                    self._check_limits(db, user_id)
+                    self._check_limits(db, user_id, sandboxes=len(spec.nodes))
                     record = self._record(run_id, user_id, request, spec)
                     # The robot's turn is claimed before the run is stored: a refused run (not
                     # your turn, not connected) leaves no record, like any other refused
@@ -217,8 +229,37 @@ class RunService:
                 raise
         return record
 
-    def _check_limits(self, db, user_id: str) -> None:
-        """Raises RunLimitError (or DiskBudgetError) when this student or the lab is full."""
+    @contextlib.contextmanager
+    def launch_file_job(self, user_id: str) -> Iterator[None]:
+        """Hold one of the student's sandbox jobs while a Python launch file is read in the
+        sandbox for a run (server/runs/launch_py.py): refused, before any sandbox starts, when
+        the run that follows could not start either or the student's sandbox budget is full."""
+        with self.store.exclusive_session() as db:
+            self._check_limits(db, user_id, sandboxes=0)  # the run's own limits first
+            self._check_sandboxes(db, user_id, 1, "reading a Python launch file")
+            lease = sandbox_leases.take(
+                db, user_id, "launch file", 1, time.time(), self._launch_lease_s
+            )
+        try:
+            yield
+        finally:
+            with self.store.session() as db:
+                sandbox_leases.give_back(db, lease)
+
+    def _check_sandboxes(self, db, user_id: str, sandboxes: int, what: str) -> None:
+        """Raises RunLimitError (RunRequestError for a job too large for any wait to help)
+        when a job of `sandboxes` sandboxes does not fit the student's sandbox budget."""
+        held = sandbox_leases.holding(db, user_id, time.time())
+        refusal = self.sandbox_budget.refusal(held, sandboxes, what)
+        if refusal is None:
+            return
+        if not refusal.waiting_helps:
+            raise RunRequestError(refusal.sentence)
+        raise RunLimitError(refusal.sentence, self.settings.retry_after_s)
+
+    def _check_limits(self, db, user_id: str, sandboxes: int) -> None:
+        """Raises RunLimitError (or DiskBudgetError) when this student or the lab is full; with
+        `sandboxes`, when a run of that many nodes does not fit the student's sandbox budget."""
         mine = run_store.active_count(db, user_id)
         total = run_store.active_count(db)
         disk.check_budgets(db, user_id, self.settings)  # measured sizes, summed
@@ -234,6 +275,8 @@ class RunService:
                 f"try again in {self.settings.retry_after_s} s",
                 self.settings.retry_after_s,
             )
+        if sandboxes:
+            self._check_sandboxes(db, user_id, sandboxes, f"this run's {sandboxes} nodes")
 
     def _record(self, run_id: str, user_id: str, request: RunRequest, spec: RunSpec) -> RunRecord:
         """The run's record as it is first stored: "created", not yet taken by a worker."""

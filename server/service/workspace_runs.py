@@ -9,7 +9,8 @@ from __future__ import annotations
 
 import logging
 import uuid
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
+from contextlib import AbstractContextManager, nullcontext
 
 from sqlalchemy.orm import Session as Db
 
@@ -53,11 +54,13 @@ def launch_plan(
     launch_file: str,
     args: Mapping[str, str],
     launcher: Launcher | None,
+    sandbox_job: Callable[[], AbstractContextManager[None]] = nullcontext,
 ) -> LaunchPlan:
     """The nodes (with their params, remaps, args and namespaces), the global parameters and
     the reader's notes of a launch file of the workspace `files`; LaunchFileError (a 422 with
     the reader's sentence, which names the file and the line) for anything wrong in it. A ROS 2
-    Python launch file is evaluated in a sandboxed job of `launcher`, never in this process."""
+    Python launch file is evaluated in a sandboxed job of `launcher`, never in this process,
+    inside `sandbox_job()` (RunService.launch_file_job: the student's sandbox budget)."""
     name = workspace_files.file_name(launch_file)
     if not (name.endswith(LAUNCH_EXTENSIONS) or is_python_launch(name, files.get(name))):
         raise RunRequestError(
@@ -70,6 +73,15 @@ def launch_plan(
             f"there is no launch file '{name}' in your workspace; "
             + (f"its launch files: {', '.join(found)}" if found else "it has no launch file yet")
         )
+    # A refusal of the job (the student's sandbox budget is full) is the service's, not the
+    # reader's: it is raised as it is, before the try below.
+    with sandbox_job() if is_python_launch(name, files[name]) else nullcontext():
+        return _read(name, files, args, launcher)
+
+
+def _read(
+    name: str, files: Mapping[str, str], args: Mapping[str, str], launcher: Launcher | None
+) -> LaunchPlan:
     try:
         return read_launch(name, files, dict(args), launcher)
     except LaunchFileError:

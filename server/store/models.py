@@ -220,3 +220,18 @@ class WorkerRecord(Base):
     robots: Mapped[list] = mapped_column(JSON, default=list)  # bench robots it holds
     started_at: Mapped[float] = mapped_column(Float)
     last_seen: Mapped[float] = mapped_column(Float, index=True)
+
+
+class SandboxLease(Base):
+    """A sandbox job of a student that is not a run (a launch file being read), held while it
+    runs, so every web process counts it in the student's sandbox budget (server/service/
+    sandbox_budget.py). A process that died holding one frees it at `expires_at`."""
+
+    __tablename__ = "sandbox_leases"
+
+    id: Mapped[str] = mapped_column(String(ID_LENGTH), primary_key=True)
+    user_id: Mapped[str] = mapped_column(ForeignKey("users.id", ondelete="CASCADE"), index=True)
+    kind: Mapped[str] = mapped_column(String(32))  # what the job is, as a sentence says it
+    sandboxes: Mapped[int] = mapped_column(Integer)  # sandbox processes it holds
+    created_at: Mapped[float] = mapped_column(Float)
+    expires_at: Mapped[float] = mapped_column(Float, index=True)

@@ -223,8 +223,13 @@ def _nodes_and_files(
             files = workspace_runs.contents(db, caller.id, workspace)
     plan = None
     if body.launch is not None:
+        service = service_of(request)
         plan = workspace_runs.launch_plan(
-            files, body.launch.file, body.launch.args, service_of(request).launcher
+            files,
+            body.launch.file,
+            body.launch.args,
+            service.launcher,
+            lambda: service.launch_file_job(caller.id),  # one of the student's sandbox jobs
         )
         nodes = plan.nodes
     else:
