@@ -14,6 +14,7 @@ from fastapi.responses import JSONResponse
 from sqlalchemy.exc import DataError
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
+from server.api import declared_errors
 from server.runs.spec import RunSpecError
 from server.service.catalog import UnknownIdError
 from server.service.disk import DiskBudgetError
@@ -145,6 +146,7 @@ def _document(app: FastAPI) -> None:
             if "HTTPValidationError" in components:
                 components["HTTPValidationError"] = VALIDATION_ERROR_SCHEMA
             components.pop("ValidationError", None)
+            declared_errors.declare(app, schema)  # every status each operation can answer
             app.openapi_schema = schema
         return app.openapi_schema
 
