@@ -218,6 +218,8 @@ class NodeHost:
             slot.newest_sensor_s = newest_sensor_s
         if slot.last_wake_ns is not None:
             slot.metrics.period.add((now_ns - slot.last_wake_ns) / NS_PER_S)
+        if slot.wake_at_ns is not None and slot.wake_at_ns <= now_ns:  # not a message first
+            slot.metrics.woke_late(now_ns / NS_PER_S, (now_ns - slot.wake_at_ns) / NS_PER_S)
         slot.last_wake_ns = now_ns
         slot.metrics.wakes += 1
         slot.woken_at_wall = time.perf_counter()

@@ -9,11 +9,12 @@ import os
 import signal
 import subprocess
 import sys
+from pathlib import Path
 
 import psutil
 import pytest
 
-from server.exercises.grading import grade, reference_nodes, starter_nodes
+from server.exercises.grading import cases_of, grade, reference_nodes, starter_nodes
 from server.exercises.registry import (
     UnknownExerciseError,
     exercise_ids,
@@ -104,22 +105,66 @@ def _command_line(process: psutil.Process) -> str:
         return ""
 
 
-@pytest.mark.slow
-def test_check_interrupted_from_the_keyboard_says_so_and_leaves_no_process():
-    command = [sys.executable, "-m", "server.cli", "check", "crop_row_fuzzy", "--reference"]
-    check = subprocess.Popen(
-        command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True
-    )
-    cli = psutil.Process(check.pid)
+def _alive(process: psutil.Process) -> bool:
+    """Running, and not a zombie waiting to be reaped (its work is over)."""
     try:
-        workers = wait_until(
-            lambda: [p for p in cli.children() if "server.cli" in _command_line(p)],
-            60,
-            "the check's worker processes started",
+        return process.is_running() and process.status() != psutil.STATUS_ZOMBIE
+    except psutil.Error:
+        return False
+
+
+# A node that never ends its part: on the realtime clock a run lasts its duration in wall time
+# (crop_row_fuzzy's 120 s), so the check cannot finish before the Ctrl-C reaches it, however
+# slowly a loaded machine gets there. Its log line says that its run is underway.
+UNDERWAY = "running until the check is interrupted"
+UNTIL_INTERRUPTED = f"""\
+import rospy
+
+rospy.init_node("until_interrupted")
+rospy.loginfo("{UNDERWAY}")
+rospy.spin()
+"""
+
+
+def _runs_underway(runs: Path) -> int:
+    """How many of a check's runs (in its --out folder `runs`) have their node running."""
+    logs = runs.glob("*/logs/until_interrupted.log")
+    return sum(UNDERWAY in log.read_text() for log in logs)
+
+
+@pytest.mark.slow
+def test_check_interrupted_from_the_keyboard_says_so_and_leaves_no_process(tmp_path):
+    node = tmp_path / "until_interrupted.py"
+    node.write_text(UNTIL_INTERRUPTED)
+    runs = tmp_path / "runs"
+    command = [sys.executable, "-m", "server.cli", "check", "crop_row_fuzzy", "--clock=realtime"]
+    command += ["--node", str(node), "--out", str(runs)]
+    # A suite started in the background by a shell without job control ignores SIGINT, and an
+    # ignored signal stays ignored across exec: the check would never hear the Ctrl-C and would
+    # grade. A handled one is reset to the default, as a terminal's foreground job has it.
+    handler = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        check = subprocess.Popen(
+            command,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+            start_new_session=True,
         )
+    finally:
+        signal.signal(signal.SIGINT, signal.SIG_DFL if handler is None else handler)
+    cli = psutil.Process(check.pid)
+    # Every run underway: each worker has left the check's process group (one the Ctrl-C caught
+    # still in it would print a traceback of its own) and started its node.
+    each_run = len(cases_of(get_exercise("crop_row_fuzzy")))
+    try:
         wait_until(
-            lambda: any(worker.children() for worker in workers), 60, "a worker started its nodes"
+            lambda: _runs_underway(runs) == each_run,
+            60,
+            f"the node of each of the check's {each_run} runs is running",
         )
+        # Its workers, their sandboxes and nodes, named while they run.
+        processes = {p: _command_line(p) for p in cli.children(recursive=True)}
         os.killpg(check.pid, signal.SIGINT)  # Ctrl-C in a terminal: the whole process group
         out, err = check.communicate(timeout=60)
     finally:  # a failed wait must not leave the check running, nor its pipes to the collector
@@ -131,4 +176,8 @@ def test_check_interrupted_from_the_keyboard_says_so_and_leaves_no_process():
         "robodojo: check interrupted from the keyboard; no grade"
     )
     assert "Traceback" not in err and out == ""
-    wait_until(lambda: not any(w.is_running() for w in workers), 30, "the workers ended")
+    assert any("server.cli" in line for line in processes.values()), processes
+    assert any("bwrap" in line for line in processes.values()), processes
+    wait_until(
+        lambda: not any(_alive(p) for p in processes), 30, "the workers and their nodes ended"
+    )

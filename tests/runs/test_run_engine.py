@@ -82,6 +82,10 @@ def test_a_controller_drives_the_crowbot_to_the_wall(tmp_path, launcher, code):
     assert result.metrics["collisions"] == 0
     period = result.nodes["controller"]["period"]
     assert period["p50_s"] == pytest.approx(0.1 if "RATE_HZ" in code else 0.05)
+    # Lockstep wakes every node at the time it asked for.
+    assert result.nodes["controller"]["wake_lateness"]["count"] > 100
+    assert result.nodes["controller"]["wake_lateness"]["max_s"] == 0.0
+    assert result.nodes["controller"]["latest_wakes"] == []
     assert (tmp_path / "run" / "recording.mcap").is_file()
 
 
@@ -158,6 +162,9 @@ def test_realtime_run_keeps_wall_time(tmp_path, launcher):
     assert result.state is RunState.FINISHED, result.reason
     assert 3.0 <= result.metrics["clock_wall_s"] < 3.3  # real-time factor 1
     assert result.nodes["controller"]["period"]["p50_s"] == pytest.approx(0.1, abs=0.01)
+    # Each wake comes some microseconds or more after its time, and the run says when.
+    late = result.nodes["controller"]["latest_wakes"]
+    assert late and all(0.0 < wake["late_s"] < 0.1 and 0.0 < wake["at_s"] < 3.0 for wake in late)
 
 
 def test_recording_has_every_declared_topic_with_its_schema(tmp_path, launcher):
