@@ -87,6 +87,29 @@ def build_command(
     font_cache: str | None = None,
 ) -> list[str]:
     """The full argv: bwrap, its options, then the Python runner and `runner_args`."""
+    command = walls(scratch_bytes)
+    if font_cache:
+        command += ["--ro-bind", font_cache, FONT_CACHE_DIR]
+    # bwrap is started with this same environment (sandbox_environment); --clearenv and these
+    # --setenv make the node's independent of what bwrap was given, should a caller forget.
+    for name, value in sandbox_environment(font_cache).items():
+        command += ["--setenv", name, value]
+    # The root itself is a tmpfs bwrap made; without this a node could fill memory writing to /.
+    command += ["--remount-ro", "/"]
+    command += ["--seccomp", str(seccomp_fd)]
+    command += [sys.executable, "-I", "-S", "-c", runner_bootstrap(SANDBOX_ROOT), *runner_args]
+    return command
+
+
+def walls(
+    scratch_bytes: int,
+    hostname: str = "robodojo-node",
+    proc: bool = True,
+    workdir: str = SCRATCH_DIR,
+) -> list[str]:
+    """bwrap and the options every sandbox shares (the module docstring's list, up to the
+    environment, the seccomp filter and the program): a node's, and the editor's analysis
+    (sandbox/editor_walls.py: no /proc, another working directory)."""
     bwrap = bwrap_path()
     if bwrap is None:
         raise SandboxUnavailable(
@@ -99,7 +122,7 @@ def build_command(
         "--unshare-user",
         "--uid", str(NOBODY),
         "--gid", str(NOBODY),
-        "--hostname", "robodojo-node",
+        "--hostname", hostname,
         "--cap-drop", "ALL",
         "--die-with-parent",
         "--new-session",
@@ -111,11 +134,11 @@ def build_command(
         "--symlink", "usr/lib64", "/lib64",
         "--ro-bind-try", "/etc/fonts", "/etc/fonts",
         "--ro-bind-try", "/etc/ld.so.cache", "/etc/ld.so.cache",
-        "--proc", "/proc",
+        *(("--proc", "/proc") if proc else ()),
         "--dev", "/dev",
         "--size", str(TMP_BYTES), "--tmpfs", "/tmp",
         "--size", str(scratch_bytes), "--tmpfs", SCRATCH_DIR,
-        "--chdir", SCRATCH_DIR,
+        "--chdir", workdir,
     ]  # fmt: skip
     roots = _python_roots()
     for root in roots:
@@ -127,16 +150,6 @@ def build_command(
     if server_dir and any(server_dir.startswith(root + os.sep) for root in visible):
         command += ["--tmpfs", server_dir]
     command += ["--ro-bind", sandbox_package_dir(), f"{SANDBOX_ROOT}/sandbox"]
-    if font_cache:
-        command += ["--ro-bind", font_cache, FONT_CACHE_DIR]
-    # bwrap is started with this same environment (sandbox_environment); --clearenv and these
-    # --setenv make the node's independent of what bwrap was given, should a caller forget.
-    for name, value in sandbox_environment(font_cache).items():
-        command += ["--setenv", name, value]
-    # The root itself is a tmpfs bwrap made; without this a node could fill memory writing to /.
-    command += ["--remount-ro", "/"]
-    command += ["--seccomp", str(seccomp_fd)]
-    command += [sys.executable, "-I", "-S", "-c", runner_bootstrap(SANDBOX_ROOT), *runner_args]
     return command
 
 

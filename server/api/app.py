@@ -102,10 +102,10 @@ def create_app(settings: Settings | None = None, launcher: Launcher | None = Non
         # The service listens to the hub (a run past its robot's slot is stopped); the hub
         # knows no service.
         app.state.runs = RunService(store, settings, run_launcher, app.state.hardware)
-        # The editor's analysis workers start and warm up in the background (seconds).
+        # The editor's analysis sandbox starts and warms up in the background (seconds).
         app.state.editor = EditorService(
             settings.max_code_bytes_per_file, settings.editor_workers,
-            settings.data / "cache" / "editor",
+            settings.data / "cache" / "editor", sandboxed=not settings.unsafe_no_sandbox,
         )  # fmt: skip
         app.state.editor.start()
         url = bootstrap(store, settings)

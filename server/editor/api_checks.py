@@ -254,9 +254,9 @@ class Checker:
 
 @cache
 def _other_robots_topics() -> dict[str, frozenset[str]]:
-    from server.sim import get_robot, robot_ids
+    from server.editor.context import robot_catalog
 
-    return {r: frozenset(t.name for t in get_robot(r).topics()) for r in robot_ids()}
+    return {r: frozenset(name for name, _, _ in rows) for r, rows in robot_catalog().items()}
 
 
 def _top_function(tree: ast.Module, name: str) -> ast.FunctionDef | ast.AsyncFunctionDef | None:

@@ -8,6 +8,13 @@ in-process environment (no helper interpreter), and `load_unsafe_extensions` off
 not import compiled modules from the project's folders; for the standard library's and numpy's
 compiled parts it reads typeshed and the installed packages' stubs.
 
+jedi sees only the paths it is given: modules are looked for there alone (not through this
+process's import machinery, whose editable-install finder and imported modules named the
+server's own packages), the sys.path modifications it would follow in the student's text
+(`sys.path.append("/anywhere")`) are ignored, and file names are completed inside the project
+folder only (`open("/root/` offers nothing). In the lab this runs inside the
+editor's sandbox (server/editor/host.py), whose walls show nothing of the server besides.
+
 The step API's `obs` is given its robot's type by a one-line prelude: the analysed text is
 `from _robodojo_step_<robot> import Observation ...` followed by the student's file, with
 `def step(obs` annotated. Positions are shifted by that line and back.
@@ -15,6 +22,8 @@ The step API's `obs` is given its robot's type by a one-line prelude: the analys
 
 from __future__ import annotations
 
+import importlib.machinery
+import os
 import re
 import sys
 from pathlib import Path
@@ -45,13 +54,24 @@ KINDS = {  # jedi's completion types -> the contract's
 
 
 class Analyser:
-    """jedi over a file, with a project per dialect (their `std_msgs` differ)."""
+    """jedi over a file, with a project per dialect (their `std_msgs` differ).
+
+    `project_dir`: the folder the student's file is analysed as being in, and the only one
+    whose file names are completed (default: `stub_root/project`); `library_root`: the folder
+    that holds the `sandbox` package rospy's source imports (default: `stub_root/common`)."""
 
     def __init__(
-        self, stub_root: Path, robots: tuple[str, ...], cache_dir: Path | None = None
+        self,
+        stub_root: Path,
+        robots: tuple[str, ...],
+        cache_dir: Path | None = None,
+        project_dir: Path | None = None,
+        library_root: Path | None = None,
     ) -> None:
         self.stub_root = stub_root
         self.robots = robots
+        self.project_dir = project_dir or stub_root / "project"
+        confine_jedi(self.project_dir)
         # jedi keeps what it parsed (numpy's, rospy's source) on disk: a fresh worker, or one
         # that replaced a killed one, starts warm when this folder outlives it.
         jedi.settings.cache_directory = str(cache_dir or stub_root / "jedi-cache")
@@ -61,11 +81,11 @@ class Analyser:
         stdlib = f"/lib/python{sys.version_info[0]}.{sys.version_info[1]}"
         libraries = [p for p in sys.path if p and ("site-packages" in p or p.endswith(
             (stdlib, ".zip", "lib-dynload")))]  # fmt: skip
-        common = str(stub_root / "common")
+        common = str(library_root or stub_root / "common")
         self.environment = jedi.InterpreterEnvironment()
         self.projects = {
             version: jedi.Project(
-                stub_root / "project",
+                self.project_dir,
                 sys_path=[str(stub_root / folder), str(SANDBOX_DIR / compat), common, *libraries],
                 smart_sys_path=False,
                 load_unsafe_extensions=False,
@@ -89,7 +109,7 @@ class Analyser:
             )
             text = f"{prelude_line}\n{text}"
             prelude = 1
-        path = self.stub_root / "project" / "controller.py"
+        path = self.project_dir / "controller.py"
         script = jedi.Script(
             text, path=path, project=self.projects[dialect], environment=self.environment
         )
@@ -172,6 +192,54 @@ class Analyser:
     def _in_stubs(self, name) -> bool:
         path = name.module_path
         return path is not None and Path(path).is_relative_to(self.stub_root)
+
+
+class _ConfinedOs:
+    """The `os` jedi's file-name completion sees: listing a folder outside `root` finds
+    nothing (an absolute path, `..`, a link out)."""
+
+    def __init__(self, root: Path) -> None:
+        self._root = os.path.realpath(root)
+
+    def __getattr__(self, name: str):
+        return getattr(os, name)
+
+    def scandir(self, path):
+        real = os.path.realpath(path)
+        if real != self._root and not real.startswith(self._root + os.sep):
+            raise FileNotFoundError(path)
+        return os.scandir(real)
+
+
+def _find_on_given_path(string, path=None, full_name=None, is_global_search=True):
+    """jedi's `_find_module`, asking only for the interpreter's built-in modules and the path
+    jedi was given: not the process's other finders (an editable install's named the server's
+    own packages) nor sys.modules (the modules this process has imported)."""
+    from jedi.inference.compiled.subprocess import functions
+
+    if path is None and string in sys.builtin_module_names:
+        spec = importlib.machinery.BuiltinImporter.find_spec(string)
+    else:
+        spec = importlib.machinery.PathFinder.find_spec(string, path)
+    if spec is None:
+        raise ImportError(f"no module {string} on the analysis' path")
+    if spec.loader is None and not spec.has_location:  # a namespace package
+        paths = spec.submodule_search_locations._path
+        return functions.ImplicitNSInfo(string if not path else full_name, paths), True
+    return functions._from_loader(spec.loader, string)
+
+
+def confine_jedi(project_dir: Path) -> None:
+    """jedi from now on in this process: modules found on its given path only, no sys.path
+    taken from the analysed text, and file names completed within `project_dir` only (module
+    docstring)."""
+    import jedi.api.file_name
+    import jedi.inference.compiled.subprocess.functions
+    import jedi.inference.sys_path
+
+    jedi.inference.compiled.subprocess.functions._find_module = _find_on_given_path
+    jedi.inference.sys_path.check_sys_path_modifications = lambda module_context: []
+    jedi.api.file_name.os = _ConfinedOs(project_dir)
 
 
 def _added_on_line(line: str) -> int:

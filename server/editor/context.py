@@ -7,6 +7,28 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 Topics = tuple[tuple[str, str], ...]  # (name, ROS 1 type name "pkg/Name")
+TopicRow = tuple[str, str, str]  # (name, "pkg/Name", "publish" or "subscribe": the robot's side)
+_catalog: dict[str, tuple[TopicRow, ...]] | None = None
+
+
+def robot_catalog() -> dict[str, tuple[TopicRow, ...]]:
+    """Every robot's topics by robot id: from server.sim in the server; inside the editor's
+    sandbox, which has no server.sim, what the server gave the host (`install_robot_catalog`)."""
+    global _catalog
+    if _catalog is None:
+        from server.sim import get_robot, robot_ids
+
+        _catalog = {
+            robot: tuple((t.name, t.type_name, str(t.direction)) for t in get_robot(robot).topics())
+            for robot in robot_ids()
+        }
+    return _catalog
+
+
+def install_robot_catalog(catalog: dict[str, list[list[str]]]) -> None:
+    global _catalog
+    _catalog = {robot: tuple((str(n), str(t), str(d)) for n, t, d in rows)
+                for robot, rows in catalog.items()}  # fmt: skip
 
 
 @dataclass(frozen=True, slots=True)
@@ -19,13 +41,11 @@ class RobotTopics:
 
     @classmethod
     def of(cls, robot_id: str | None, extra: Topics = ()) -> RobotTopics | None:
-        from server.sim import get_robot, robot_ids
-
-        if robot_id is None or robot_id not in robot_ids():
+        rows = robot_catalog().get(robot_id) if robot_id is not None else None
+        if rows is None:
             return None
-        topics = get_robot(robot_id).topics()
-        types = {t.name: t.type_name for t in topics}
-        sensors = [t.name for t in topics if str(t.direction) == "publish"]
+        types = {name: type_name for name, type_name, _ in rows}
+        sensors = [name for name, _, direction in rows if direction == "publish"]
         for name, type_name in extra:
             types.setdefault(name, type_name)
             if name not in sensors:

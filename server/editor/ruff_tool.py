@@ -1,24 +1,31 @@
-"""Ruff, run as a program on the student's text (never on a file of theirs): `ruff check` for
-pyflakes' findings and syntax errors (rules F and E9, no style nags), `ruff format` on request.
-`--isolated` so no configuration file near the server's working folder changes what students
-get; a fixed file name, so nothing of the request reaches ruff's command line.
+"""Ruff on the student's text (never on a file of theirs): `ruff check` for pyflakes' findings
+and syntax errors (rules F and E9, no style nags), `ruff format` on request. Ruff runs inside
+the editor's sandbox, one process per request (server/editor/host.py runs these arguments);
+this module says what it is asked and reads what it answers.
+
+`--isolated` so no configuration file near ruff's working folder changes what students get; a
+fixed file name, so nothing of the request reaches ruff's command line; findings as JSON lines,
+so an answer cut at the host's output cap still reads up to its last whole line.
 """
 
 from __future__ import annotations
 
 import json
-import subprocess
 from functools import cache
 
 from server.editor import syntax
 from server.editor.diagnostics import Diagnostic, Severity
-from server.editor.limits import LIMITS
 
 STDIN_NAME = "controller.py"
 RULES = "F,E9"  # pyflakes (undefined names, unused imports, ...) and syntax errors
 # ruff 0.5-0.11 gives syntax errors no code, later ones "invalid-syntax"; the contract names
 # them E999, ruff's old code, as editors and students know it.
 SYNTAX_RULE = syntax.SYNTAX_RULE
+
+
+CHECK_ARGUMENTS = ("check", "--isolated", "--no-cache", "--select", RULES, "--output-format",
+                   "json-lines", "--stdin-filename", STDIN_NAME, "--exit-zero", "-")  # fmt: skip
+FORMAT_ARGUMENTS = ("format", "--isolated", "--no-cache", "--stdin-filename", STDIN_NAME, "-")
 
 
 class RuffUnavailable(RuntimeError):
@@ -36,36 +43,20 @@ def ruff_binary() -> str:
     return str(find_ruff_bin())
 
 
-def _run(arguments: list[str], code: str, timeout_s: float) -> subprocess.CompletedProcess:
-    try:
-        return subprocess.run(
-            [ruff_binary(), *arguments],
-            input=code.encode(),
-            capture_output=True,
-            timeout=timeout_s,
-            check=False,
+def diagnostics(answer: dict) -> list[Diagnostic]:
+    """Ruff's findings from the host's answer to CHECK_ARGUMENTS, with positions as the
+    contract gives them."""
+    if answer["returncode"] != 0 and not answer["truncated"]:
+        raise RuffUnavailable(
+            f"the linter failed on this file (exit status {answer['returncode']})"
         )
-    except subprocess.TimeoutExpired:
-        raise RuffUnavailable(f"the linter stopped after {timeout_s:g} s on this file") from None
-    except (OSError, ImportError) as error:
-        raise RuffUnavailable(f"the linter could not start ({error})") from None
-
-
-def check(code: str) -> list[Diagnostic]:
-    """Ruff's findings for `code`, with positions as the contract gives them."""
-    done = _run(
-        ["check", "--isolated", "--no-cache", "--select", RULES, "--output-format", "json",
-         "--stdin-filename", STDIN_NAME, "--exit-zero", "-"],
-        code,
-        LIMITS.ruff_timeout_s,
-    )  # fmt: skip
-    if done.returncode != 0:
-        raise RuffUnavailable(f"the linter failed on this file (exit status {done.returncode})")
+    lines = answer["stdout"].splitlines()
+    if answer["truncated"] and lines:
+        lines.pop()  # cut at the cap: the last line may be part of a finding
     try:
-        findings = json.loads(done.stdout)
-    except ValueError:
+        return [_diagnostic(json.loads(line)) for line in lines if line.strip()]
+    except (ValueError, KeyError, TypeError):
         raise RuffUnavailable("the linter's answer could not be read") from None
-    return [_diagnostic(item) for item in findings]
 
 
 def _diagnostic(item: dict) -> Diagnostic:
@@ -99,16 +90,17 @@ def _sentence(message: str) -> str:
     return message if message.endswith((".", "?", "!")) else message + "."
 
 
-def format_code(code: str) -> str:
-    """`code` as ruff format writes it; FormatError naming the line for a syntax error."""
-    done = _run(
-        ["format", "--isolated", "--no-cache", "--stdin-filename", STDIN_NAME, "-"],
-        code,
-        LIMITS.format_timeout_s,
-    )
-    if done.returncode == 0:
-        return done.stdout.decode()
-    error = done.stderr.decode(errors="replace").strip().splitlines()
+def formatted(answer: dict) -> str:
+    """The text from the host's answer to FORMAT_ARGUMENTS; FormatError naming the line for a
+    syntax error."""
+    if answer["truncated"]:
+        raise FormatError(
+            "cannot format this file: the formatted text would be larger than the editor "
+            "takes back; split the file into modules"
+        )
+    if answer["returncode"] == 0:
+        return answer["stdout"]
+    error = answer["stderr"].strip().splitlines()
     text = error[0] if error else ""
     # "error: Failed to parse controller.py:3:7: Expected ..."
     _, _, why = text.partition(f"{STDIN_NAME}:")

@@ -2,13 +2,15 @@
 
 `sandbox.msgs` and `sandbox.msgs2` build their classes on first use from a table, so a static
 analyser reading their source sees no `Twist` and no `linear`. This module writes, once per
-worker start, a plain Python package per message package (`geometry_msgs/msg/__init__.py` with
+server start, a plain Python package per message package (`geometry_msgs/msg/__init__.py` with
 `class Twist:` and its annotated fields) from those same classes, and an `Observation` class
 per robot for the step API. jedi reads these files as text; nothing here is ever imported.
 
     root/ros1/    message packages as ROS 1 has them, _robodojo_step_<robot>.py
     root/ros2/    message packages as ROS 2 has them (msg, srv, action)
     root/common/  a link to the real `sandbox` package, which rospy's and rclpy's source imports
+                  (for an Analyser in the server's own process, as the tests make; the editor's
+                  sandbox shows jedi /opt/robodojo instead, which holds `sandbox` alone)
 """
 
 from __future__ import annotations
@@ -17,11 +19,14 @@ import hashlib
 import os
 from pathlib import Path
 
+import sandbox
 from server.editor.context import Topics
 from server.editor.messages import ROS1, ROS2, MessageInfo, message_info, packages
 
 STEP_MODULE = "_robodojo_step_{robot}"  # the step API's stub module of a robot
-SANDBOX_DIR = Path(__file__).resolve().parents[2] / "sandbox"
+# The sandbox package as this process sees it: the checkout's in the server, the bound copy
+# (/opt/robodojo/sandbox) inside the editor's sandbox.
+SANDBOX_DIR = Path(sandbox.__file__).resolve().parent
 HEADER = '"""Written by server/editor/stubs.py for the editor\'s analysis; never imported."""\n'
 
 

@@ -1,7 +1,9 @@
 """The editor's help while a student types: diagnostics, completion with signature help, hover
 and formatting (server/editor). The robot whose topics the analysis knows comes from the
 exercise (or the free-play workspace's robot, or `robot`). Nothing here runs the student's
-code: it is read by ruff and jedi as text (docs/architecture.md, "Editor")."""
+code: it is read by ruff and jedi as text, inside the editor's sandbox (docs/architecture.md,
+"Editor"). Each student has one request analysed at a time behind a bounded queue: past it,
+429 with a sentence."""
 
 from __future__ import annotations
 
@@ -12,7 +14,7 @@ from server.api.auth import Caller, current_user
 from server.api.schemas import HARD_CODE_CAP, Strict
 from server.editor.context import RunContext, builtin_topics
 from server.editor.ruff_tool import FormatError, RuffUnavailable
-from server.editor.service import CodeTooLarge, EditorService, InvalidText
+from server.editor.service import CodeTooLarge, EditorBusy, EditorService, InvalidText
 from server.service import catalog, exercises
 from server.sim import robot_ids
 
@@ -53,51 +55,54 @@ def _context(request: Request, body: AnalysedText) -> RunContext:
     return RunContext(exercise.robot, builtin_topics(exercise.builtin_nodes))
 
 
-def _too_large(error: CodeTooLarge) -> HTTPException:
-    return HTTPException(413, str(error))
+def _refused(error: Exception) -> HTTPException:
+    """The HTTP answer to a refusal every route shares."""
+    if isinstance(error, CodeTooLarge):
+        return HTTPException(413, str(error))
+    if isinstance(error, EditorBusy):
+        return HTTPException(429, str(error))
+    return HTTPException(422, str(error))  # InvalidText
+
+
+REFUSALS = (CodeTooLarge, EditorBusy, InvalidText)
 
 
 @router.post("/lint", summary="Diagnostics: ruff's (pyflakes, syntax) and RoboDojo's API checks")
-def lint(body: AnalysedText, request: Request, _: Caller = Depends(current_user)) -> dict:
+def lint(body: AnalysedText, request: Request, caller: Caller = Depends(current_user)) -> dict:
     try:
-        return {"diagnostics": _service(request).lint(body.code, _context(request, body))}
-    except CodeTooLarge as error:
-        raise _too_large(error) from None
-    except InvalidText as error:
-        raise HTTPException(422, str(error)) from None
+        context = _context(request, body)
+        return {"diagnostics": _service(request).lint(body.code, context, caller.id)}
+    except REFUSALS as error:
+        raise _refused(error) from None
 
 
 @router.post("/complete", summary="Completions and signature help at the cursor")
-def complete(body: Position, request: Request, _: Caller = Depends(current_user)) -> dict:
+def complete(body: Position, request: Request, caller: Caller = Depends(current_user)) -> dict:
     try:
         return _service(request).complete(
-            body.code, body.line, body.column, _context(request, body)
+            body.code, body.line, body.column, _context(request, body), caller.id
         )
-    except CodeTooLarge as error:
-        raise _too_large(error) from None
-    except InvalidText as error:
-        raise HTTPException(422, str(error)) from None
+    except REFUSALS as error:
+        raise _refused(error) from None
 
 
 @router.post("/hover", summary="What the name at the cursor is: a field's type and unit")
-def hover(body: Position, request: Request, _: Caller = Depends(current_user)) -> dict:
+def hover(body: Position, request: Request, caller: Caller = Depends(current_user)) -> dict:
     try:
-        return _service(request).hover(body.code, body.line, body.column, _context(request, body))
-    except CodeTooLarge as error:
-        raise _too_large(error) from None
-    except InvalidText as error:
-        raise HTTPException(422, str(error)) from None
+        return _service(request).hover(
+            body.code, body.line, body.column, _context(request, body), caller.id
+        )
+    except REFUSALS as error:
+        raise _refused(error) from None
 
 
 @router.post("/format", summary="The text as ruff format writes it")
-def format_code(body: EditorText, request: Request, _: Caller = Depends(current_user)) -> dict:
+def format_code(body: EditorText, request: Request, caller: Caller = Depends(current_user)) -> dict:
     try:
-        return {"code": _service(request).format(body.code)}
-    except CodeTooLarge as error:
-        raise _too_large(error) from None
-    except InvalidText as error:
-        raise HTTPException(422, str(error)) from None
+        return {"code": _service(request).format(body.code, caller.id)}
+    except REFUSALS as error:
+        raise _refused(error) from None
     except FormatError as error:
         raise HTTPException(422, str(error)) from None
     except RuffUnavailable as error:
-        raise HTTPException(503, f"{error}; try again in a moment") from None
+        raise HTTPException(503, str(error)) from None  # the sentence says when to ask again
