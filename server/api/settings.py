@@ -100,8 +100,9 @@ class Settings(BaseSettings):
     keep_alive_timeout_s: int = Field(5, ge=1)  # [s] idle between requests (uvicorn's default)
     max_header_bytes: int = Field(32 * KIB, ge=1024)  # [B] request line + headers (h11: 16 KiB)
 
-    # The editor's analysis (server/editor): worker processes for completion and our checks,
-    # ~150 MiB each; 0 turns the editor's help off (its routes say so).
+    # The editor's analysis (server/editor): requests analysed at once, each in a sandboxed
+    # process of its own, a student's one at a time; 0 turns the editor's help off (its routes
+    # say so).
     editor_workers: int = Field(2, ge=0, le=16)
 
     unsafe_no_sandbox: bool = False  # trusted machines only: student code runs unconfined
