@@ -100,13 +100,26 @@ def library_roots(inside: bool) -> list[str]:
     return [package, "/usr", *bwrap._python_roots()]
 
 
-def limit_request(address_space_bytes: int, cpu_seconds: int, open_files: int) -> None:
+def limit_request(
+    address_space_bytes: int, cpu_seconds: int, open_files: int, cpu_life_seconds: int = 0
+) -> None:
     """A request's rlimits: soft and hard equal, so a request cannot raise them again (CPU:
-    SIGXCPU at the limit, SIGKILL a second later)."""
+    SIGXCPU at `cpu_seconds`, SIGKILL a second later). A process that answers several requests
+    (a student's, server/editor/host.py) moves its CPU limit on before each, up to
+    `cpu_life_seconds` for its whole life (`next_cpu_limit`)."""
     resource.setrlimit(resource.RLIMIT_CORE, (0, 0))  # a crash leaves no file, anywhere
     resource.setrlimit(resource.RLIMIT_NOFILE, (open_files, open_files))
-    resource.setrlimit(resource.RLIMIT_CPU, (cpu_seconds, cpu_seconds + 1))
+    hard = max(cpu_life_seconds, cpu_seconds + 1)
+    resource.setrlimit(resource.RLIMIT_CPU, (cpu_seconds, hard))
     resource.setrlimit(resource.RLIMIT_AS, (address_space_bytes, address_space_bytes))
+
+
+def next_cpu_limit(cpu_seconds: int) -> None:
+    """`cpu_seconds` more of CPU from now on (within the life's hard limit)."""
+    used = resource.getrusage(resource.RUSAGE_SELF)
+    _, hard = resource.getrlimit(resource.RLIMIT_CPU)
+    soft = int(used.ru_utime + used.ru_stime) + cpu_seconds
+    resource.setrlimit(resource.RLIMIT_CPU, (min(soft, hard), hard))
 
 
 def seal_request(runs_program: bool) -> None:

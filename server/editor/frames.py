@@ -46,12 +46,14 @@ class Ready(msgspec.Struct, tag=True, frozen=True):
 
 
 class Job(msgspec.Struct, tag=True, frozen=True):
-    """Analyse `code` (`op`); line and column for completion and hover (1-based line, 0-based
+    """Analyse `code` (`op`) for `user` (whose analysis process may answer their next jobs
+    too, never another's); line and column for completion and hover (1-based line, 0-based
     column); the robot and the topics its exercise's built-in nodes publish."""
 
     id: int
     op: Op
     code: str
+    user: str = ""
     line: int = 1
     column: int = 0
     robot: str | None = None

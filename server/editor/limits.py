@@ -40,6 +40,17 @@ class EditorLimits:
     ruff_memory_bytes: int = 256 * MiB
     # Open files of a request's process: jedi reads one module at a time.
     request_open_files: int = 64
+    # A student's analysis process answers their next requests too (request.py: a completion
+    # in ~65 ms instead of ~112 ms), this many students' at once, the least recently served let
+    # go first; each holds ~30-100 MiB of its own copies of the host's pages and caches.
+    sessions: int = 4
+    # ... until the student has sent nothing for this long [s] (thinking, reading the run) ...
+    session_idle_s: float = 60.0
+    # ... or has been answered this many times (jedi's caches of edited texts grow) ...
+    session_requests: int = 500
+    # ... or has used this much CPU in all (RLIMIT_CPU's hard limit; each request still has
+    # its own CPU seconds, below) [s].
+    session_cpu_seconds: int = 600
     # What ruff check may send back [bytes]: a file of garbage gets megabytes of findings (a
     # 200 KB f-string: 14 MB); the first 256 KiB hold more than max_diagnostics below.
     ruff_check_output_bytes: int = 256 * 1024

@@ -87,8 +87,8 @@ class EditorService:
     def lint(self, code: str, context: RunContext, user: str = ANYONE) -> list[dict]:
         self.check_size(code)
         with self.gate.turn(user, "lint"):
-            from_ruff_job = self.host.submit(Op.RUFF_CHECK, code)
-            checks_job = self.host.submit(Op.CHECKS, code, **self._context(context))
+            from_ruff_job = self.host.submit(Op.RUFF_CHECK, code, user=user)
+            checks_job = self.host.submit(Op.CHECKS, code, user=user, **self._context(context))
             found: list[Diagnostic] = []
             python_syntax: list[Diagnostic] = []
             try:
@@ -119,7 +119,7 @@ class EditorService:
         self.check_size(code)
         with self.gate.turn(user, "complete"):
             job = self.host.submit(
-                Op.COMPLETE, code, line=line, column=column, **self._context(context)
+                Op.COMPLETE, code, user=user, line=line, column=column, **self._context(context)
             )
             try:
                 return self.host.result(job)
@@ -132,7 +132,7 @@ class EditorService:
         self.check_size(code)
         with self.gate.turn(user, "hover"):
             job = self.host.submit(
-                Op.HOVER, code, line=line, column=column, **self._context(context)
+                Op.HOVER, code, user=user, line=line, column=column, **self._context(context)
             )
             try:
                 return self.host.result(job)
@@ -145,7 +145,7 @@ class EditorService:
         self.check_size(code)
         with self.gate.turn(user, "format"):
             try:
-                answer = self.host.result(self.host.submit(Op.RUFF_FORMAT, code))
+                answer = self.host.result(self.host.submit(Op.RUFF_FORMAT, code, user=user))
             except AnalysisUnavailable as error:
                 if error.cause in FILE_CAUSES:  # the file is the reason: asking again won't do
                     raise ruff_tool.FormatError(f"cannot format this file: {error}") from None

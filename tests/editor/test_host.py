@@ -5,7 +5,9 @@ learns kept for the next; a host that dies replaced."""
 
 from __future__ import annotations
 
+import logging
 import os
+import re
 import signal
 import time
 
@@ -42,6 +44,21 @@ def test_the_host_answers_checks_completion_and_hover(editor):
                          RunContext(None))  # fmt: skip
     assert hover == {"text": "range_max: float32 [m]"}
     assert "Distance" in labels(complete(editor, "def step(obs):\n    obs.", "crowbot"))
+
+
+def test_a_students_process_answers_their_next_requests_and_no_one_elses(editor, caplog):
+    """Which process answered which job, from the host's log lines (at debug level)."""
+    caplog.set_level(logging.DEBUG, logger="robodojo.editor")
+    for user in ("ada", "bob", "ada", "bob", "ada"):
+        assert "init_node" in labels(complete(editor, "import rospy\nrospy.", user=user))
+    served = [re.search(r"in process (\d+) for student (\w+)", r.getMessage())
+              for r in caplog.records if "complete: answered" in r.getMessage()]  # fmt: skip
+    pairs = [(m.group(2), m.group(1)) for m in served[-5:]]
+    by_student: dict[str, set[str]] = {}
+    for student, pid in pairs:
+        by_student.setdefault(student, set()).add(pid)
+    assert len(by_student) == 2 and all(len(pids) == 1 for pids in by_student.values()), pairs
+    assert not set.intersection(*by_student.values())  # no process served both
 
 
 def test_a_request_past_its_budget_is_stopped_with_a_sentence_and_the_host_goes_on(editor):
