@@ -50,6 +50,7 @@ pytestmark = pytest.mark.skipif(
 def start(*args: str, **kwargs) -> subprocess.Popen:
     # The environment this test runs in, so scripts/venv finds its stamp and installs nothing.
     environment = {**os.environ, "ROBODOJO_VENV": sys.prefix}
+    environment.pop("ROBODOJO_FRESH_VENV", None)  # CI's: it would rebuild this environment
     return subprocess.Popen(
         [str(START), *args], cwd=kwargs.pop("cwd", ROOT), env=environment, text=True, **kwargs
     )

@@ -64,6 +64,16 @@ def _rss_kib(pid: int) -> int:
     return 0
 
 
+def _is_editor(pid: int) -> bool:
+    """The editor's analysis sandbox (its bwrap names the host robodojo-editor): not a run or
+    launch-file job, and not in this budget (issue 33 leaves editor jobs out of it for now)."""
+    try:
+        with open(f"/proc/{pid}/cmdline", "rb") as cmdline:
+            return b"robodojo-editor" in cmdline.read()
+    except OSError:
+        return False
+
+
 def sandboxes_of(server_pid: int) -> tuple[int, int]:
     """(sandboxes the server has started, [KiB] their processes' resident memory): each is a
     bwrap process whose parent is not one (bwrap forks itself to be pid 1 inside)."""
@@ -71,7 +81,7 @@ def sandboxes_of(server_pid: int) -> tuple[int, int]:
     stack = list(tree.get(server_pid, []))
     while stack:
         pid = stack.pop()
-        if _comm(pid) == "bwrap":
+        if _comm(pid) == "bwrap" and not _is_editor(pid):
             sandboxes += 1
             inside = list(tree.get(pid, []))
             while inside:
