@@ -84,15 +84,16 @@ class EditorLimits:
     # Time the server gives the host past a job's budget before it takes it for stuck and
     # starts another [s] (the host kills requests itself; this is for a host that stopped).
     host_grace_s: float = 5.0
-    # The host's own address space [bytes]: jedi's caches of the warm-up and of what it learns
-    # take ~300 MiB, the libraries' mappings more. Past this the host is replaced.
+    # The host's own address space [bytes]: warm, it maps ~200-250 MiB (~120-180 MiB
+    # resident: jedi's caches of the warm-up and of what it learns). Past this it fails and is
+    # replaced.
     host_address_space_bytes: int = 2048 * MiB
     # Library modules the host parses for later requests (host.py); a lab's students import a
     # few dozen besides the warm-up's.
     learned_modules: int = 2000
-    # The sandbox's memory, where a memory cgroup exists [bytes]: the host (~300 MiB) and
-    # 2 x concurrent_requests request processes (a lint runs ruff and our checks at once), the
-    # pages each writes of its inherited copy of the host counted.
+    # The sandbox's memory, where a memory cgroup exists [bytes]: 135 MiB idle (host, twin,
+    # spares; proportional set sizes), ~540 MiB with 4 students' processes warm, and room for
+    # the requests at once at their caps (a lint runs ruff and our checks together).
     sandbox_memory_bytes: int = 2048 * MiB
     # Threads and processes of the sandbox together (pids cgroup): bwrap, the host, the
     # request processes (one thread each; ruff a few).
