@@ -18,12 +18,12 @@ from __future__ import annotations
 
 import argparse
 import os
-import re
 import time
 from pathlib import Path
 
 import psutil
 from _common import percentile
+from bench_editor import completion_points
 
 from server.editor.context import RunContext
 from server.editor.service import EditorService
@@ -76,16 +76,6 @@ def main():
 main()
 '''
 READY_TIMEOUT_S = 300.0  # [s] the analysis' cold start on a loaded 2-core machine
-
-
-def completion_points(code: str) -> list[tuple[int, int]]:
-    """(line, column) just after each `name.` of the file (1-based line, 0-based column)."""
-    points = []
-    for number, text in enumerate(code.split("\n"), start=1):
-        if text.lstrip().startswith("#"):
-            continue
-        points += [(number, m.end()) for m in re.finditer(r"\b[A-Za-z_]\w*\.(?=[A-Za-z_])", text)]
-    return points
 
 
 def report(label: str, seconds: list[float]) -> None:

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import pytest
 
+from tests.editor.hostile_texts import DEEPLY_NESTED
 from tests.waiting import wait_until
 
 READY_S = 180.0  # [s] the analysis workers' start and warm-up on a loaded 2-core machine
@@ -153,15 +154,7 @@ def test_a_5_mb_file_is_refused_before_it_is_read(lab):
     assert answer.json()["detail"]  # a sentence, from the body limit
 
 
-@pytest.mark.parametrize(
-    "code",
-    [
-        "x = " + "(" * 5000 + ")" * 5000 + "\n",
-        "x = " + "1+" * 100_000 + "1\n",
-        "".join("    " * i + "if True:\n" for i in range(120)) + "    " * 120 + "pass\n",
-    ],
-    ids=["brackets", "long-sum", "indentation"],
-)
+@pytest.mark.parametrize("code", DEEPLY_NESTED.values(), ids=DEEPLY_NESTED.keys())
 def test_deeply_nested_code_is_answered_quickly(student, code):
     answer = student.post("/api/editor/lint", json=body(code))
     assert answer.status_code == 200

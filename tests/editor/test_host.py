@@ -16,6 +16,7 @@ import pytest
 from server.editor.context import RunContext
 from server.editor.frames import Op
 from tests.editor.conftest import START_S, cursor_at_end, started_service
+from tests.editor.hostile_texts import DEEPLY_NESTED
 from tests.waiting import wait_until
 
 CHECKS_TEXT = "from std_msgs.msg import Int32\nInt32().dta\n"
@@ -81,15 +82,7 @@ def test_a_request_past_its_budget_is_stopped_with_a_sentence_and_the_host_goes_
     assert "init_node" in labels(complete(editor, "import rospy\nrospy."))
 
 
-@pytest.mark.parametrize(
-    "code",
-    [
-        "x = " + "(" * 5000 + ")" * 5000 + "\n",
-        "x = " + "1+" * 100_000 + "1\n",
-        "".join("    " * i + "if True:\n" for i in range(120)) + "    " * 120 + "pass\n",
-    ],
-    ids=["brackets", "long-sum", "indentation"],
-)
+@pytest.mark.parametrize("code", DEEPLY_NESTED.values(), ids=DEEPLY_NESTED.keys())
 def test_hostile_text_is_answered_without_running_into_a_limit(editor, code):
     assert complete(editor, code) == {"completions": [], "signature": None}
     found = editor.lint(code, RunContext(None))
